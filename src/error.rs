@@ -1,0 +1,70 @@
+//! Library error type. The CLI wraps these with `anyhow` context.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in the library, with enough context to act on.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A scenario value is missing, out of range or inconsistent; `field` is its TOML path.
+    #[error("invalid scenario: `{field}`: {reason}")]
+    Config {
+        /// Dotted TOML path of the offending field, e.g. `fluid.viscosity`.
+        field: String,
+        /// Why the value was refused.
+        reason: String,
+    },
+    /// A file could not be parsed as a scenario.
+    #[error("cannot parse scenario {path}: {message}")]
+    Parse {
+        /// The scenario file.
+        path: PathBuf,
+        /// The parser's message (it names the line and the field).
+        message: String,
+    },
+    /// The simulation became unstable (NaN, non-positive density, Mach too high).
+    #[error("unstable at step {step} (t = {time:.6e} s), cell ({x}, {y}): {reason}")]
+    Unstable {
+        /// Time step at which the check failed.
+        step: u64,
+        /// Simulated time in seconds.
+        time: f64,
+        /// Cell column.
+        x: usize,
+        /// Cell row.
+        y: usize,
+        /// What was wrong there.
+        reason: String,
+    },
+    /// Reading or writing a file failed.
+    #[error("i/o error on {path}: {source}")]
+    Io {
+        /// The file or folder involved.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// Anything else, with a message.
+    #[error("{0}")]
+    Other(String),
+}
+
+/// Library result type.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl Error {
+    /// Shorthand for [`Error::Config`].
+    pub fn config(field: impl Into<String>, reason: impl Into<String>) -> Self {
+        Error::Config {
+            field: field.into(),
+            reason: reason.into(),
+        }
+    }
+
+    /// Shorthand for [`Error::Io`].
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+}

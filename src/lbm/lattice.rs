@@ -1,0 +1,488 @@
+//! Population storage and the fused stream–collide step (AA pattern, in place).
+//!
+//! Populations are structure-of-arrays: `f[i·n + y·nx + x]`, one contiguous array per direction,
+//! the layout a GPU kernel would use too. Streaming is the AA pattern (Bailey et al. 2009), which
+//! needs a single copy of the populations and touches each value once per step:
+//!
+//! * **even step**: node x reads its own slots, f_i = A[x][i], collides, and writes
+//!   A[x][ī] = f_i*;
+//! * **odd step**: node x reads f_i = A[x − e_i][ī] (the value its neighbour wrote last step),
+//!   collides, and writes A[x + e_i][i] = f_i*.
+//!
+//! Every slot is read and written by exactly one node in each step, so rows run in parallel
+//! (rayon) with no second array. Nodes whose 8 neighbours are plain fluid ("bulk") run through a
+//! vectorised loop over runs of a row; the rest ("special": next to a wall, a solid or an edge)
+//! go through a per-link path that applies half-way bounce-back and the Zou–He closure
+//! ([`super::boundary`]). Links into obstacles are listed with their wall distance q so that
+//! [`super::obstacle`] can apply interpolated bounce-back and momentum exchange after the step.
+
+use rayon::prelude::*;
+
+use super::boundary::{zou_he, Edge, Edges, Neighbour, ZouHe, ZouHeNode};
+use super::collision::Collider;
+use super::d2q9::{equilibrium, CX, CY, OPP, Q, W};
+use super::real::Real;
+
+/// Cells processed together in the vectorised bulk loop.
+const LANES: usize = 16;
+
+/// A non-bulk fluid node.
+#[derive(Clone, Debug)]
+pub(crate) struct Special {
+    pub cell: u32,
+    /// What lies at x + e_i.
+    pub nb: [Neighbour; Q],
+    pub zou_he: Option<ZouHeNode>,
+}
+
+/// Work for one row.
+#[derive(Clone, Debug, Default)]
+struct RowPlan {
+    /// Half-open x ranges of bulk nodes.
+    runs: Vec<(u32, u32)>,
+    /// Indices into `specials`.
+    specials: Vec<u32>,
+}
+
+/// The D2Q9 populations of a rectangular domain with its walls, obstacles and edges.
+pub struct Lattice<T> {
+    /// Cells along x.
+    pub nx: usize,
+    /// Cells along y.
+    pub ny: usize,
+    f: Vec<T>,
+    solid: Vec<bool>,
+    edges: Edges,
+    /// Bounce-back correction 6 w_i ρ₀ (e_i·u_w) per wall velocity; entry 0 is a wall at rest.
+    wall_corr: Vec<[T; Q]>,
+    rows: Vec<RowPlan>,
+    pub(crate) specials: Vec<Special>,
+    /// For each cell, its index in `specials` or `u32::MAX`.
+    special_of: Vec<u32>,
+    /// True when the next step is even.
+    even: bool,
+}
+
+/// A raw pointer that may cross threads; see the SAFETY notes where it is dereferenced.
+#[derive(Clone, Copy)]
+struct Shared<T>(*mut T);
+unsafe impl<T> Send for Shared<T> {}
+unsafe impl<T> Sync for Shared<T> {}
+
+impl<T: Real> Lattice<T> {
+    /// A lattice of `nx × ny` cells with the given edges and solid mask (`solid[y·nx + x]`),
+    /// filled with fluid at rest at unit density.
+    ///
+    /// Edge velocities and densities are in lattice units. Fails (with the reason) when the edges
+    /// are inconsistent, or a Zou–He profile has the wrong length.
+    pub fn new(nx: usize, ny: usize, edges: Edges, solid: Vec<bool>) -> Result<Self, String> {
+        assert_eq!(solid.len(), nx * ny, "solid mask size");
+        edges.check().map_err(|(name, why)| format!("edges {name}: {why}"))?;
+        for (name, e, len) in [
+            ("left", &edges.left, ny),
+            ("right", &edges.right, ny),
+            ("bottom", &edges.bottom, nx),
+            ("top", &edges.top, nx),
+        ] {
+            if let Edge::Velocity(p) = e {
+                if p.len() != len {
+                    return Err(format!("edge {name}: velocity profile has {} nodes, expected {len}", p.len()));
+                }
+            }
+        }
+        if nx < 3 || ny < 3 {
+            return Err(format!("the lattice needs at least 3×3 cells, got {nx}×{ny}"));
+        }
+        let n = nx * ny;
+        let mut lat = Lattice {
+            nx,
+            ny,
+            f: vec![T::zero(); Q * n],
+            solid,
+            edges,
+            wall_corr: vec![[T::zero(); Q]],
+            rows: Vec::new(),
+            specials: Vec::new(),
+            special_of: vec![u32::MAX; n],
+            even: true,
+        };
+        lat.plan();
+        lat.fill(|_, _| (1.0, 0.0, 0.0));
+        Ok(lat)
+    }
+
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// Always false: a lattice has at least 3×3 cells.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Is cell `c` solid?
+    pub fn is_solid(&self, c: usize) -> bool {
+        self.solid[c]
+    }
+
+    /// The solid mask.
+    pub fn solid(&self) -> &[bool] {
+        &self.solid
+    }
+
+    /// The edges.
+    pub fn edges(&self) -> &Edges {
+        &self.edges
+    }
+
+    /// Set every fluid cell to the equilibrium of `init(x, y) = (ρ, u_x, u_y)` (lattice units).
+    pub fn fill(&mut self, init: impl Fn(usize, usize) -> (f64, f64, f64)) {
+        let n = self.len();
+        self.even = true;
+        for y in 0..self.ny {
+            for x in 0..self.nx {
+                let c = y * self.nx + x;
+                let feq = if self.solid[c] { [0.0; Q] } else {
+                    let (r, u, v) = init(x, y);
+                    equilibrium(r, u, v)
+                };
+                for i in 0..Q {
+                    // Even step reads A[x][i] as f_i.
+                    self.f[i * n + c] = T::c(feq[i]);
+                }
+            }
+        }
+    }
+
+    /// Set every fluid cell's populations from `pops(x, y)` (pre-collision, lattice units).
+    pub fn fill_populations(&mut self, pops: impl Fn(usize, usize) -> [f64; Q]) {
+        let n = self.len();
+        self.even = true;
+        for c in 0..n {
+            let p = if self.solid[c] { [0.0; Q] } else { pops(c % self.nx, c / self.nx) };
+            for i in 0..Q {
+                self.f[i * n + c] = T::c(p[i]);
+            }
+        }
+    }
+
+    /// What lies at (x + dx, y + dy) seen from fluid node (x, y).
+    fn neighbour(&mut self, x: usize, y: usize, dx: i32, dy: i32) -> Neighbour {
+        let (nx, ny) = (self.nx as i64, self.ny as i64);
+        let (mut tx, mut ty) = (x as i64 + dx as i64, y as i64 + dy as i64);
+        if self.edges.left == Edge::Periodic {
+            tx = tx.rem_euclid(nx);
+        }
+        if self.edges.bottom == Edge::Periodic {
+            ty = ty.rem_euclid(ny);
+        }
+        let edge = if ty < 0 {
+            Some(self.edges.bottom.clone())
+        } else if ty >= ny {
+            Some(self.edges.top.clone())
+        } else if tx < 0 {
+            Some(self.edges.left.clone())
+        } else if tx >= nx {
+            Some(self.edges.right.clone())
+        } else {
+            None
+        };
+        match edge {
+            None => {
+                let c = (ty * nx + tx) as usize;
+                if self.solid[c] { Neighbour::Bounce(0) } else { Neighbour::Fluid(c as u32) }
+            }
+            Some(Edge::Wall { velocity }) => Neighbour::Bounce(self.wall_index(velocity)),
+            Some(Edge::Periodic) => unreachable!("periodic coordinates were wrapped"),
+            Some(_) => Neighbour::Open,
+        }
+    }
+
+    fn wall_index(&mut self, u: [f64; 2]) -> u16 {
+        if u == [0.0, 0.0] {
+            return 0;
+        }
+        let corr: [T; Q] =
+            std::array::from_fn(|i| T::c(6.0 * W[i] * (CX[i] as f64 * u[0] + CY[i] as f64 * u[1])));
+        if let Some(k) = self.wall_corr.iter().position(|c| *c == corr) {
+            return k as u16;
+        }
+        self.wall_corr.push(corr);
+        (self.wall_corr.len() - 1) as u16
+    }
+
+    /// The Zou–He node at (x, y), if a link of it is open.
+    fn zou_he_node(&self, x: usize, y: usize, nb: &[Neighbour; Q]) -> Option<ZouHeNode> {
+        let open = (1..Q).find(|&i| nb[i] == Neighbour::Open)?;
+        let ox = x as i64 + CX[open] as i64;
+        let oy = y as i64 + CY[open] as i64;
+        // The same priority as `neighbour`: the y edges first.
+        let (edge, normal, k) = if oy < 0 {
+            (&self.edges.bottom, [0, 1], x)
+        } else if oy >= self.ny as i64 {
+            (&self.edges.top, [0, -1], x)
+        } else if ox < 0 {
+            (&self.edges.left, [1, 0], y)
+        } else {
+            (&self.edges.right, [-1, 0], y)
+        };
+        let value = match edge {
+            Edge::Velocity(p) => ZouHe::Velocity(p[k]),
+            Edge::Pressure(rho) => ZouHe::Pressure(*rho),
+            _ => unreachable!("open links lead to Zou-He edges"),
+        };
+        Some(ZouHeNode { normal, value })
+    }
+
+    /// Classify every fluid node as bulk or special and build the row plans.
+    fn plan(&mut self) {
+        let (nx, ny) = (self.nx, self.ny);
+        self.rows = vec![RowPlan::default(); ny];
+        self.specials.clear();
+        for y in 0..ny {
+            let mut run_start: Option<usize> = None;
+            for x in 0..nx {
+                let c = y * nx + x;
+                let mut bulk = false;
+                if !self.solid[c] {
+                    let nb: [Neighbour; Q] =
+                        std::array::from_fn(|i| if i == 0 { Neighbour::Fluid(c as u32) } else { Neighbour::Open });
+                    let mut nb = nb;
+                    for i in 1..Q {
+                        nb[i] = self.neighbour(x, y, CX[i], CY[i]);
+                    }
+                    let all_fluid = nb.iter().all(|n| matches!(n, Neighbour::Fluid(_)));
+                    // Bulk nodes read shifted slices of their row, so they must not wrap in x.
+                    bulk = all_fluid && x > 0 && x + 1 < nx;
+                    if !bulk {
+                        let zou_he = self.zou_he_node(x, y, &nb);
+                        self.special_of[c] = self.specials.len() as u32;
+                        self.rows[y].specials.push(self.specials.len() as u32);
+                        self.specials.push(Special { cell: c as u32, nb, zou_he });
+                    }
+                }
+                match (bulk, run_start) {
+                    (true, None) => run_start = Some(x),
+                    (false, Some(s)) => {
+                        self.rows[y].runs.push((s as u32, x as u32));
+                        run_start = None;
+                    }
+                    _ => {}
+                }
+            }
+            if let Some(s) = run_start {
+                self.rows[y].runs.push((s as u32, nx as u32));
+            }
+        }
+    }
+
+    /// True if the next step is even (populations in natural layout, A[x][i] = f_i(x)).
+    pub fn next_is_even(&self) -> bool {
+        self.even
+    }
+
+    /// One fused stream–collide step.
+    pub fn step(&mut self, collider: &Collider<T>) {
+        let (nx, ny, n, even) = (self.nx, self.ny, self.len(), self.even);
+        let base = Shared(self.f.as_mut_ptr());
+        let specials = &self.specials;
+        let wall_corr = &self.wall_corr;
+        self.rows.par_iter().enumerate().for_each(|(y, plan)| {
+            let base = base;
+            for &(x0, x1) in &plan.runs {
+                // SAFETY: within a step each slot is read and written by exactly one node (see
+                // module docs); bulk nodes of row y touch slots of their own node (even) or of
+                // their 8 in-domain neighbours (odd), which no other node touches.
+                unsafe { bulk_run(base.0, n, nx, ny, y, x0 as usize, x1 as usize, even, collider) };
+            }
+            for &s in &plan.specials {
+                // SAFETY: as above; special nodes touch only their own link slots.
+                unsafe { special_node(base.0, n, &specials[s as usize], even, collider, wall_corr) };
+            }
+        });
+        self.even = !even;
+    }
+
+    /// Pre-collision populations of fluid cell `c` at the current time (after streaming and
+    /// boundary closure): what the next step will collide.
+    pub fn populations(&self, c: usize) -> [T; Q] {
+        let n = self.len();
+        let f = &self.f;
+        let s = self.special_of[c];
+        if s != u32::MAX {
+            let sp = &self.specials[s as usize];
+            // SAFETY: read-only access through a pointer derived from a shared borrow.
+            return unsafe { gather(f.as_ptr() as *mut T, n, sp, self.even, &self.wall_corr).0 };
+        }
+        if self.even {
+            std::array::from_fn(|i| f[i * n + c])
+        } else {
+            let (x, y) = ((c % self.nx) as i64, (c / self.nx) as i64);
+            std::array::from_fn(|i| {
+                let sx = x - CX[i] as i64;
+                let sy = (y - CY[i] as i64).rem_euclid(self.ny as i64);
+                f[OPP[i] * n + (sy * self.nx as i64 + sx) as usize]
+            })
+        }
+    }
+
+    /// Raw slot A[c][i] (for momentum exchange and interpolated bounce-back).
+    #[inline]
+    pub(crate) fn slot(&self, i: usize, c: usize) -> T {
+        self.f[i * self.len() + c]
+    }
+
+    /// Overwrite slot A[c][i].
+    #[inline]
+    pub(crate) fn set_slot(&mut self, i: usize, c: usize, v: T) {
+        let n = self.len();
+        self.f[i * n + c] = v;
+    }
+
+    /// Sum of all populations of fluid cells (total mass, lattice units), accumulated in f64.
+    pub fn total_mass(&self) -> f64 {
+        (0..self.len())
+            .into_par_iter()
+            .filter(|&c| !self.solid[c])
+            .map(|c| self.populations(c).iter().map(|v| v.f64()).sum::<f64>())
+            .sum()
+    }
+
+    /// Bytes of population storage.
+    pub fn bytes(&self) -> usize {
+        self.f.len() * std::mem::size_of::<T>()
+    }
+}
+
+/// Collide one run of bulk nodes of row `y`.
+///
+/// # Safety
+/// `f` points to `Q·n` values; `x0..x1` are bulk nodes of row `y` and no other thread touches
+/// their link slots during this step.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+unsafe fn bulk_run<T: Real>(
+    f: *mut T,
+    n: usize,
+    nx: usize,
+    ny: usize,
+    y: usize,
+    x0: usize,
+    x1: usize,
+    even: bool,
+    collider: &Collider<T>,
+) {
+    // Offset of the slot each direction uses, relative to the node's own index.
+    let row = y * nx;
+    let offs: [usize; Q] = std::array::from_fn(|i| {
+        if even {
+            i * n + row
+        } else {
+            let yy = (y as i64 + CY[i] as i64).rem_euclid(ny as i64) as usize;
+            ((i * n + yy * nx) as i64 + CX[i] as i64) as usize
+        }
+    });
+    let mut x = x0;
+    let mut buf = [[T::zero(); LANES]; Q];
+    while x < x1 {
+        let len = LANES.min(x1 - x);
+        for i in 0..Q {
+            // Even: f_i = A[x][i]. Odd: slot of direction i holds f_ī.
+            let dst = if even { i } else { OPP[i] };
+            std::ptr::copy_nonoverlapping(f.add(offs[i] + x), buf[dst].as_mut_ptr(), len);
+            for l in len..LANES {
+                buf[dst][l] = buf[dst][0];
+            }
+        }
+        collider.collide(&mut buf);
+        for i in 0..Q {
+            // Even: A[x][ī] = f_i*. Odd: A[x + e_i][i] = f_i*.
+            let slot = if even { OPP[i] } else { i };
+            std::ptr::copy_nonoverlapping(buf[i].as_ptr(), f.add(offs[slot] + x), len);
+        }
+        x += len;
+    }
+}
+
+/// Gather the pre-collision populations of a special node and the mask of unknown ones, and
+/// apply the Zou–He closure.
+///
+/// # Safety
+/// `f` points to `Q·n` values; only reads.
+unsafe fn gather<T: Real>(
+    f: *mut T,
+    n: usize,
+    sp: &Special,
+    even: bool,
+    wall_corr: &[[T; Q]],
+) -> ([T; Q], u16) {
+    let c = sp.cell as usize;
+    let mut g = [T::zero(); Q];
+    let mut unknown = 0u16;
+    for j in 0..Q {
+        // The population arriving along e_j comes from x − e_j, i.e. across link ī.
+        match sp.nb[OPP[j]] {
+            Neighbour::Fluid(k) => {
+                g[j] = if even { *f.add(j * n + c) } else { *f.add(OPP[j] * n + k as usize) };
+            }
+            Neighbour::Bounce(w) => {
+                // f_j = f_ī* − 6 w_ī (e_ī·u_w): applied here for values written by an even step,
+                // at the write for those written by an odd step.
+                let v = *f.add(j * n + c);
+                g[j] = if even { v } else { v + wall_corr[w as usize][j] };
+            }
+            Neighbour::Open => {
+                unknown |= 1 << j;
+            }
+        }
+    }
+    if let Some(node) = &sp.zou_he {
+        zou_he(&mut g, unknown, node);
+    }
+    (g, unknown)
+}
+
+/// Stream–collide one special node.
+///
+/// # Safety
+/// As [`bulk_run`].
+unsafe fn special_node<T: Real>(
+    f: *mut T,
+    n: usize,
+    sp: &Special,
+    even: bool,
+    collider: &Collider<T>,
+    wall_corr: &[[T; Q]],
+) {
+    let c = sp.cell as usize;
+    let (g, _) = gather(f, n, sp, even, wall_corr);
+    let mut buf: [[T; 1]; Q] = std::array::from_fn(|i| [g[i]]);
+    collider.collide(&mut buf);
+    for i in 0..Q {
+        let v = buf[i][0];
+        if even {
+            *f.add(OPP[i] * n + c) = v;
+        } else {
+            match sp.nb[i] {
+                Neighbour::Fluid(k) => *f.add(i * n + k as usize) = v,
+                Neighbour::Bounce(w) => *f.add(OPP[i] * n + c) = v - wall_corr[w as usize][i],
+                Neighbour::Open => {}
+            }
+        }
+    }
+}
+
+impl<T: Real> Lattice<T> {
+    /// Copy of the populations and the parity, for snapshots.
+    pub fn state(&self) -> (Vec<T>, bool) {
+        (self.f.clone(), self.even)
+    }
+
+    /// Restore a state from [`Lattice::state`].
+    pub fn set_state(&mut self, f: Vec<T>, even: bool) {
+        assert_eq!(f.len(), self.f.len(), "snapshot of another lattice");
+        self.f = f;
+        self.even = even;
+    }
+}

@@ -1,0 +1,23 @@
+//! D2Q9 lattice Boltzmann fluid solver (seed sections 5.1–5.3).
+//!
+//! * [`d2q9`]: velocity set, weights, equilibrium.
+//! * [`collision`]: BGK, MRT, Smagorinsky LES, Guo forcing.
+//! * [`lattice`]: population storage (structure of arrays) and the in-place AA stream–collide.
+//! * [`boundary`]: periodic, half-way bounce-back (resting or moving), Zou–He edges.
+//! * [`obstacle`]: shapes, interpolated bounce-back, momentum-exchange forces.
+//! * [`solver`]: the solver in time, its [`Scale`](crate::scale::Scale) implementation.
+
+pub mod boundary;
+pub mod collision;
+pub mod d2q9;
+pub mod lattice;
+pub mod obstacle;
+pub mod real;
+pub mod solver;
+
+pub use boundary::{Edge, Edges};
+pub use collision::{CollisionModel, Collider, MrtRates};
+pub use lattice::Lattice;
+pub use obstacle::{Obstacle, Obstacles, Shape};
+pub use real::Real;
+pub use solver::{Fluid, Lbm, Macroscopic};

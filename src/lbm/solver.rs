@@ -1,0 +1,262 @@
+//! The fluid solver: a lattice, its collision operator and obstacles, advanced in time; and
+//! the precision-erased [`Fluid`] interface the CLI and the coupling drivers use.
+
+use super::collision::Collider;
+use super::d2q9::{CX, CY, Q};
+use super::lattice::Lattice;
+use super::obstacle::Obstacles;
+use super::real::Real;
+use crate::scale::Scale;
+use crate::units::{Units, CS2};
+use crate::{Error, Result};
+
+/// Macroscopic fields in lattice units, one value per cell (`y·nx + x`). Solid cells hold
+/// ρ = 1, u = 0.
+#[derive(Clone, Debug, Default)]
+pub struct Macroscopic {
+    /// Cells along x.
+    pub nx: usize,
+    /// Cells along y.
+    pub ny: usize,
+    /// Density ρ = Σ f_i.
+    pub rho: Vec<f64>,
+    /// Velocity u_x = (Σ f_i e_ix + F_x/2)/ρ.
+    pub ux: Vec<f64>,
+    /// Velocity u_y.
+    pub uy: Vec<f64>,
+    /// Solid mask.
+    pub solid: Vec<bool>,
+}
+
+impl Macroscopic {
+    /// Vorticity ω = ∂u_y/∂x − ∂u_x/∂y by central differences (one-sided at edges and next to
+    /// solids), lattice units.
+    pub fn vorticity(&self) -> Vec<f64> {
+        let (nx, ny) = (self.nx, self.ny);
+        let at = |x: usize, y: usize| y * nx + x;
+        let d = |v: &[f64], c0: usize, cm: Option<usize>, cp: Option<usize>| -> f64 {
+            match (cm, cp) {
+                (Some(m), Some(p)) => 0.5 * (v[p] - v[m]),
+                (None, Some(p)) => v[p] - v[c0],
+                (Some(m), None) => v[c0] - v[m],
+                (None, None) => 0.0,
+            }
+        };
+        let ok = |c: usize| (!self.solid[c]).then_some(c);
+        (0..nx * ny)
+            .map(|c| {
+                if self.solid[c] {
+                    return 0.0;
+                }
+                let (x, y) = (c % nx, c / nx);
+                let xm = (x > 0).then(|| at(x - 1, y)).and_then(ok);
+                let xp = (x + 1 < nx).then(|| at(x + 1, y)).and_then(ok);
+                let ym = (y > 0).then(|| at(x, y - 1)).and_then(ok);
+                let yp = (y + 1 < ny).then(|| at(x, y + 1)).and_then(ok);
+                d(&self.uy, c, xm, xp) - d(&self.ux, c, ym, yp)
+            })
+            .collect()
+    }
+}
+
+/// A D2Q9 fluid in precision `T`.
+pub struct Lbm<T> {
+    /// Populations, walls and edges.
+    pub lattice: Lattice<T>,
+    /// Collision operator.
+    pub collider: Collider<T>,
+    /// Obstacles with their links and forces.
+    pub obstacles: Obstacles,
+    /// SI ↔ lattice conversion.
+    pub units: Units,
+    /// Steps taken.
+    pub steps: u64,
+}
+
+impl<T: Real> Lbm<T> {
+    /// Assemble a solver; links the obstacles to the lattice.
+    pub fn new(lattice: Lattice<T>, collider: Collider<T>, mut obstacles: Obstacles, units: Units) -> Self {
+        obstacles.link(&lattice);
+        Lbm { lattice, collider, obstacles, units, steps: 0 }
+    }
+
+    /// One lattice step.
+    pub fn step(&mut self) {
+        let was_even = self.lattice.next_is_even();
+        self.lattice.step(&self.collider);
+        self.obstacles.after_step(&mut self.lattice, was_even);
+        self.steps += 1;
+    }
+
+    /// Density and velocity of fluid cell `c` (lattice units).
+    pub fn cell(&self, c: usize) -> (f64, f64, f64) {
+        let f = self.lattice.populations(c);
+        let (mut r, mut jx, mut jy) = (0.0, 0.0, 0.0);
+        for i in 0..Q {
+            let v = f[i].f64();
+            r += v;
+            jx += v * CX[i] as f64;
+            jy += v * CY[i] as f64;
+        }
+        let [fx, fy] = self.collider.force;
+        (r, (jx + 0.5 * fx) / r, (jy + 0.5 * fy) / r)
+    }
+
+    /// Fill `m` with the macroscopic fields.
+    pub fn macroscopic_into(&self, m: &mut Macroscopic) {
+        use rayon::prelude::*;
+        let n = self.lattice.len();
+        m.nx = self.lattice.nx;
+        m.ny = self.lattice.ny;
+        let vals: Vec<(f64, f64, f64)> = (0..n)
+            .into_par_iter()
+            .map(|c| if self.lattice.is_solid(c) { (1.0, 0.0, 0.0) } else { self.cell(c) })
+            .collect();
+        m.rho = vals.iter().map(|v| v.0).collect();
+        m.ux = vals.iter().map(|v| v.1).collect();
+        m.uy = vals.iter().map(|v| v.2).collect();
+        m.solid = self.lattice.solid().to_vec();
+    }
+
+    /// First cell that is NaN, has ρ ≤ 0 or lattice Mach |u|/c_s > `max_mach`.
+    pub fn find_instability(&self, max_mach: f64) -> Option<(usize, String)> {
+        use rayon::prelude::*;
+        let cs = CS2.sqrt();
+        (0..self.lattice.len()).into_par_iter().find_first(|&c| {
+            if self.lattice.is_solid(c) {
+                return false;
+            }
+            let (r, u, v) = self.cell(c);
+            !(r > 0.0) || !u.is_finite() || !v.is_finite() || (u * u + v * v).sqrt() / cs > max_mach
+        })
+        .map(|c| {
+            let (r, u, v) = self.cell(c);
+            let reason = if r.is_nan() || u.is_nan() || v.is_nan() {
+                "NaN in the populations".to_string()
+            } else if r <= 0.0 {
+                format!("density {r:.3e} ≤ 0")
+            } else {
+                format!(
+                    "lattice Mach number {:.3} > {max_mach} (|u| = {:.3e} lattice units): reduce the time step or the velocity",
+                    (u * u + v * v).sqrt() / cs,
+                    (u * u + v * v).sqrt()
+                )
+            };
+            (c, reason)
+        })
+    }
+}
+
+/// Precision-erased fluid solver, as the CLI and drivers use it.
+pub trait Fluid: Send {
+    /// Advance `n` lattice steps.
+    fn steps(&mut self, n: u64);
+    /// Steps taken so far.
+    fn step_count(&self) -> u64;
+    /// SI ↔ lattice conversion.
+    fn units(&self) -> Units;
+    /// Macroscopic fields.
+    fn macroscopic(&self, m: &mut Macroscopic);
+    /// Density and velocity of one fluid cell (lattice units).
+    fn cell_state(&self, c: usize) -> (f64, f64, f64);
+    /// Force and torque on each obstacle in the last step (lattice units).
+    fn obstacle_loads(&self) -> (Vec<[f64; 2]>, Vec<f64>);
+    /// Total fluid mass (lattice units).
+    fn total_mass(&self) -> f64;
+    /// Stop with [`Error::Unstable`] if a cell is NaN, ρ ≤ 0 or Mach > `max_mach`.
+    fn check_stable(&self, max_mach: f64) -> Result<()>;
+    /// Bytes of population storage.
+    fn bytes(&self) -> usize;
+    /// `"f32"` or `"f64"`.
+    fn precision(&self) -> &'static str;
+}
+
+impl<T: Real> Fluid for Lbm<T> {
+    fn steps(&mut self, n: u64) {
+        for _ in 0..n {
+            self.step();
+        }
+    }
+    fn step_count(&self) -> u64 {
+        self.steps
+    }
+    fn units(&self) -> Units {
+        self.units
+    }
+    fn macroscopic(&self, m: &mut Macroscopic) {
+        self.macroscopic_into(m)
+    }
+    fn cell_state(&self, c: usize) -> (f64, f64, f64) {
+        self.cell(c)
+    }
+    fn obstacle_loads(&self) -> (Vec<[f64; 2]>, Vec<f64>) {
+        (self.obstacles.force.clone(), self.obstacles.torque.clone())
+    }
+    fn total_mass(&self) -> f64 {
+        self.lattice.total_mass()
+    }
+    fn check_stable(&self, max_mach: f64) -> Result<()> {
+        match self.find_instability(max_mach) {
+            None => Ok(()),
+            Some((c, reason)) => Err(Error::Unstable {
+                step: self.steps,
+                time: self.steps as f64 * self.units.dt,
+                x: c % self.lattice.nx,
+                y: c / self.lattice.nx,
+                reason,
+            }),
+        }
+    }
+    fn bytes(&self) -> usize {
+        self.lattice.bytes()
+    }
+    fn precision(&self) -> &'static str {
+        T::NAME
+    }
+}
+
+/// A full copy of a fluid state.
+#[derive(Clone)]
+pub struct LbmSnapshot<T> {
+    populations: Vec<T>,
+    next_even: bool,
+    steps: u64,
+}
+
+impl<T: Real> Scale for Lbm<T> {
+    /// The fluid takes no input yet (solid fractions arrive with the coupling).
+    type Input = ();
+    type Output = Macroscopic;
+    type Snapshot = LbmSnapshot<T>;
+
+    fn time(&self) -> f64 {
+        self.steps as f64 * self.units.dt
+    }
+    fn max_dt(&self) -> f64 {
+        self.units.dt
+    }
+    /// Advance by `dt`, which must be a whole number of lattice steps (within 1e-9).
+    fn advance(&mut self, _input: &(), dt: f64) -> Result<()> {
+        let n = dt / self.units.dt;
+        let k = n.round();
+        if (n - k).abs() > 1e-9 * n.max(1.0) || k < 1.0 {
+            return Err(Error::Other(format!(
+                "LBM advance: dt = {dt:e} s is not a whole number of lattice steps ({:e} s)",
+                self.units.dt
+            )));
+        }
+        Fluid::steps(self, k as u64);
+        Ok(())
+    }
+    fn observe(&self, out: &mut Macroscopic) {
+        self.macroscopic_into(out)
+    }
+    fn snapshot(&self) -> LbmSnapshot<T> {
+        let (populations, next_even) = self.lattice.state();
+        LbmSnapshot { populations, next_even, steps: self.steps }
+    }
+    fn restore(&mut self, s: LbmSnapshot<T>) {
+        self.lattice.set_state(s.populations, s.next_even);
+        self.steps = s.steps;
+    }
+}

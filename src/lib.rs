@@ -1,0 +1,27 @@
+//! # granflow
+//!
+//! A 2-D multi-scale framework for granular flows, dry and submerged. Three solvers share one
+//! crate and meet through the [`scale::Scale`] trait:
+//!
+//! | scale | module | method |
+//! |---|---|---|
+//! | fluid | [`lbm`] | D2Q9 lattice Boltzmann, BGK / MRT, Smagorinsky LES |
+//!
+//! DEM grains and the GIMPM continuum are planned (see the issues); the fluid solver, the
+//! scenario format, the output contract and the validation harness are in place.
+//!
+//! All inputs are SI. [`units::Units`] converts between SI and lattice units, with the formula
+//! in each method's documentation.
+#![warn(missing_docs)]
+
+pub mod analysis;
+pub mod config;
+pub mod error;
+pub mod io;
+pub mod lbm;
+pub mod run;
+pub mod scale;
+pub mod units;
+pub mod validate;
+
+pub use error::{Error, Result};

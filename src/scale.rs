@@ -1,0 +1,54 @@
+//! The [`Scale`] trait: how the solvers meet.
+//!
+//! Each solver (LBM fluid now; DEM grains and GIMPM continuum later) is a `Scale`: a thing with
+//! its own clock that can be advanced, observed and snapshotted. Solvers never name each other;
+//! all mapping between scales lives in a coupling driver. The verbs follow MUSCLE3's submodel
+//! loop (init → (observe → advance)* → final) and preCICE's participant.
+
+use crate::Result;
+
+/// One physical scale of a multi-scale simulation.
+pub trait Scale {
+    /// What the other scales hand it each step (e.g. solid fraction and velocity for the fluid).
+    type Input;
+    /// What it shows the other scales, written into a reused buffer.
+    type Output: Default;
+    /// A full copy of its state, to roll back or checkpoint.
+    type Snapshot: Clone + Send;
+
+    /// Current simulated time in seconds.
+    fn time(&self) -> f64;
+    /// Largest stable step in seconds (LBM: the lattice step; DEM: λ·Δt_cr; MPM: CFL step).
+    fn max_dt(&self) -> f64;
+    /// Advance by `dt` seconds with `input` held fixed; a scale may sub-step internally.
+    fn advance(&mut self, input: &Self::Input, dt: f64) -> Result<()>;
+    /// Write what the other scales need into `out`.
+    fn observe(&self, out: &mut Self::Output);
+    /// Copy the state.
+    fn snapshot(&self) -> Self::Snapshot;
+    /// Restore a state taken by [`Scale::snapshot`].
+    fn restore(&mut self, snapshot: Self::Snapshot);
+}
+
+/// Number of sub-steps of size at most `max_dt` needed to cover `dt`, and their size.
+///
+/// n = ⌈dt / max_dt⌉ (at least 1), each of size dt / n. A relative slack of 1e-9 keeps
+/// `dt = k·max_dt` from producing k + 1 steps through round-off.
+pub fn substeps(dt: f64, max_dt: f64) -> (u64, f64) {
+    let n = ((dt / max_dt) * (1.0 - 1e-9)).ceil().max(1.0) as u64;
+    (n, dt / n as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn substeps_cover_dt_without_exceeding_max() {
+        assert_eq!(substeps(1.0, 0.25), (4, 0.25));
+        let (n, h) = substeps(1.0, 0.3);
+        assert_eq!(n, 4);
+        assert!((h - 0.25).abs() < 1e-15);
+        assert_eq!(substeps(0.1, 1.0).0, 1);
+    }
+}

@@ -1,0 +1,124 @@
+//! SI ↔ lattice unit conversion for the LBM, in one type.
+//!
+//! The lattice has spacing Δx (m), step Δt (s) and reference density ρ₀ (kg/m³). Lattice
+//! quantities are dimensionless; a 2-D run is per unit depth. With c_s² = 1/3 (lattice):
+//!
+//! | quantity | SI → lattice |
+//! |---|---|
+//! | velocity | u* = u Δt/Δx |
+//! | kinematic viscosity | ν* = ν Δt/Δx², τ = 3ν* + ½ |
+//! | acceleration | g* = g Δt²/Δx |
+//! | density | ρ* = ρ/ρ₀ |
+//! | pressure (gauge) | p = ρ₀ (Δx/Δt)² c_s² (ρ* − 1) |
+//! | force per unit depth | F = F* ρ₀ Δx³/Δt² |
+//! | time | t = n Δt |
+
+use serde::Serialize;
+
+/// Lattice speed of sound squared, c_s² = 1/3 (lattice units).
+pub const CS2: f64 = 1.0 / 3.0;
+
+/// Conversion between SI and lattice units for one lattice.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Units {
+    /// Lattice spacing Δx in metres.
+    pub dx: f64,
+    /// Time step Δt in seconds.
+    pub dt: f64,
+    /// Reference density ρ₀ in kg/m³ (lattice density 1).
+    pub rho0: f64,
+}
+
+impl Units {
+    /// Units from Δx, Δt and ρ₀.
+    pub fn new(dx: f64, dt: f64, rho0: f64) -> Self {
+        Units { dx, dt, rho0 }
+    }
+
+    /// Units for a given relaxation time: Δt = (τ − ½) Δx² / (3ν) (seed eq. 5.11).
+    pub fn from_tau(dx: f64, tau: f64, nu: f64, rho0: f64) -> Self {
+        Units::new(dx, (tau - 0.5) * dx * dx / (3.0 * nu), rho0)
+    }
+
+    /// Lattice velocity u* = u Δt/Δx.
+    pub fn velocity_to_lattice(&self, u: f64) -> f64 {
+        u * self.dt / self.dx
+    }
+
+    /// SI velocity u = u* Δx/Δt.
+    pub fn velocity_to_si(&self, u: f64) -> f64 {
+        u * self.dx / self.dt
+    }
+
+    /// Lattice viscosity ν* = ν Δt/Δx².
+    pub fn viscosity_to_lattice(&self, nu: f64) -> f64 {
+        nu * self.dt / (self.dx * self.dx)
+    }
+
+    /// Relaxation time τ = 3ν* + ½ = 3νΔt/Δx² + ½ (seed eq. 5.9).
+    pub fn tau(&self, nu: f64) -> f64 {
+        3.0 * self.viscosity_to_lattice(nu) + 0.5
+    }
+
+    /// Lattice acceleration g* = g Δt²/Δx (force per unit mass).
+    pub fn acceleration_to_lattice(&self, g: f64) -> f64 {
+        g * self.dt * self.dt / self.dx
+    }
+
+    /// Gauge pressure in Pa from lattice density: p = ρ₀ (Δx/Δt)² c_s² (ρ* − 1) (seed eq. 5.7).
+    pub fn pressure_to_si(&self, rho_lattice: f64) -> f64 {
+        self.rho0 * (self.dx / self.dt).powi(2) * CS2 * (rho_lattice - 1.0)
+    }
+
+    /// Lattice density from gauge pressure in Pa, the inverse of [`Units::pressure_to_si`].
+    pub fn pressure_to_lattice_density(&self, p: f64) -> f64 {
+        1.0 + p / (self.rho0 * (self.dx / self.dt).powi(2) * CS2)
+    }
+
+    /// Density in kg/m³ from lattice density: ρ = ρ₀ ρ*.
+    pub fn density_to_si(&self, rho_lattice: f64) -> f64 {
+        self.rho0 * rho_lattice
+    }
+
+    /// Force per unit depth in N/m from lattice force: F = F* ρ₀ Δx³/Δt².
+    pub fn force_to_si(&self, f: f64) -> f64 {
+        f * self.rho0 * self.dx.powi(3) / (self.dt * self.dt)
+    }
+
+    /// Torque per unit depth in N·m/m from lattice torque: T = T* ρ₀ Δx⁴/Δt².
+    pub fn torque_to_si(&self, t: f64) -> f64 {
+        t * self.rho0 * self.dx.powi(4) / (self.dt * self.dt)
+    }
+
+    /// Vorticity in 1/s from lattice vorticity: ω = ω*/Δt.
+    pub fn rate_to_si(&self, w: f64) -> f64 {
+        w / self.dt
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn tau_round_trip() {
+        let u = Units::from_tau(0.01, 0.8, 1e-3, 1000.0);
+        assert_relative_eq!(u.tau(1e-3), 0.8, max_relative = 1e-14);
+    }
+
+    #[test]
+    fn pressure_round_trip() {
+        let u = Units::new(1e-3, 1e-4, 1000.0);
+        let rho = u.pressure_to_lattice_density(123.4);
+        assert_relative_eq!(u.pressure_to_si(rho), 123.4, max_relative = 1e-12);
+    }
+
+    #[test]
+    fn velocity_round_trip() {
+        let u = Units::new(2e-3, 5e-4, 1.0);
+        assert_relative_eq!(u.velocity_to_si(u.velocity_to_lattice(0.3)), 0.3);
+        // 0.3 m/s over 2 mm in 0.5 ms is 0.075 cells per step.
+        assert_relative_eq!(u.velocity_to_lattice(0.3), 0.075, max_relative = 1e-14);
+    }
+}

@@ -1,0 +1,33 @@
+//! Scenario files: TOML, SI units, `deny_unknown_fields`, no silent defaults for physics.
+//!
+//! [`Scenario::from_file`] parses; [`Scenario::derive`] checks every value and derives the
+//! lattice quantities ([`Derived`]), refusing — with the field named — anything unstable or
+//! meaningless. `granflow check` prints the result. The format is documented in
+//! `docs/scenario-format.md`; every file under `models/` is parsed and checked by the tests.
+
+mod fluid;
+
+pub use fluid::*;
+
+use std::path::Path;
+
+use crate::{Error, Result};
+
+impl Scenario {
+    /// Parse a scenario file.
+    pub fn from_file(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Self::from_toml(&text).map_err(|e| match e {
+            Error::Parse { message, .. } => Error::Parse { path: path.to_path_buf(), message },
+            other => other,
+        })
+    }
+
+    /// Parse scenario text.
+    pub fn from_toml(text: &str) -> Result<Self> {
+        toml::from_str(text).map_err(|e| Error::Parse {
+            path: "<text>".into(),
+            message: e.to_string(),
+        })
+    }
+}

@@ -1,0 +1,19 @@
+//! Output files: VTK (`.vti` images, `.vtu` point/line sets), ParaView collections (`.pvd`),
+//! CSV time series and JSON summaries.
+//!
+//! Every whole-file writer goes through [`write_atomic`]: the data is written to a hidden
+//! temporary file beside the target, synced, and renamed over it, so a run killed mid-write
+//! never leaves a truncated file behind. Files that grow ([`CsvWriter`]) flush after each row
+//! instead, so a killed run keeps every complete row.
+
+pub mod atomic;
+pub mod csv;
+pub mod json;
+pub mod pvd;
+pub mod vtk;
+
+pub use atomic::{write_atomic, write_atomic_bytes};
+pub use csv::CsvWriter;
+pub use json::write_json;
+pub use pvd::{PvdEntry, PvdSeries};
+pub use vtk::{write_vti, write_vtu_points, Field, FieldData, ImageGrid};

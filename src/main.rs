@@ -1,0 +1,258 @@
+//! The `granflow` command line.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand, ValueEnum};
+
+use granflow::config::Scenario;
+use granflow::validate::{self, Check, Fidelity};
+
+#[derive(Parser)]
+#[command(name = "granflow", version, about = "Multi-scale granular flows, dry and submerged")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Parse a scenario, derive and print the lattice quantities, refuse bad input; no run.
+    Check {
+        /// Scenario file (TOML).
+        scenario: PathBuf,
+    },
+    /// Run a scenario and write series.pvd + frames, timeseries.csv and summary.json.
+    Run {
+        /// Scenario file (TOML).
+        scenario: PathBuf,
+        /// Output folder (created if needed; files in it are replaced).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Run validation cases against their references.
+    Validate {
+        /// Case name, or `all`; `granflow validate list` lists them.
+        case: String,
+        /// One JSON object per checked quantity.
+        #[arg(long)]
+        json: bool,
+        /// Full resolution (slower) instead of the test resolution.
+        #[arg(long)]
+        full: bool,
+    },
+    /// Throughput benchmarks.
+    Bench {
+        #[command(subcommand)]
+        which: Bench,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Precision {
+    F32,
+    F64,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Collision {
+    Bgk,
+    Mrt,
+}
+
+#[derive(Subcommand)]
+enum Bench {
+    /// D2Q9 LBM in a periodic box, with the memory-bandwidth roofline measured beside it.
+    Lbm {
+        /// Cells along x.
+        #[arg(long, default_value_t = 2048)]
+        nx: usize,
+        /// Cells along y.
+        #[arg(long, default_value_t = 2048)]
+        ny: usize,
+        /// Steps per repeat.
+        #[arg(long, default_value_t = 100)]
+        steps: u64,
+        /// Population precision.
+        #[arg(long, value_enum, default_value_t = Precision::F32)]
+        precision: Precision,
+        /// Collision operator.
+        #[arg(long, value_enum, default_value_t = Collision::Bgk)]
+        collision: Collision,
+        /// Threads (0: all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Timed repeats; the median is reported.
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    match real_main() {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn real_main() -> Result<ExitCode> {
+    match Cli::parse().command {
+        Command::Check { scenario } => check(&scenario),
+        Command::Run { scenario, out } => run(&scenario, &out),
+        Command::Validate { case, json, full } => validate_cmd(&case, json, full),
+        Command::Bench { which } => bench(which),
+    }
+}
+
+fn check(path: &PathBuf) -> Result<ExitCode> {
+    let s = Scenario::from_file(path)?;
+    let d = s.derive()?;
+    let u = &d.units;
+    println!("scenario        {} — {}", s.name, s.description);
+    println!("cells           {} × {} = {}", d.cells[0], d.cells[1], d.cells[0] * d.cells[1]);
+    println!("dx              {:.6e} m", u.dx);
+    println!("dt              {:.6e} s", u.dt);
+    println!("tau             {:.6}", d.tau);
+    println!("nu (lattice)    {:.6e}", d.nu_lattice);
+    println!("u_ref (lattice) {:.6e}", d.u_lattice);
+    println!("Mach (lattice)  {:.4}  (limit {})", d.mach, granflow::config::MAX_MACH);
+    println!("Reynolds        {:.4}", d.reynolds);
+    println!("steps           {} ({} s)", d.steps, s.time.end);
+    println!("frames          every {} steps ({} frames)", d.frame_every, d.steps.div_ceil(d.frame_every) + 1);
+    println!("series          every {} steps", d.series_every);
+    println!("force (lattice) [{:.4e}, {:.4e}]", d.force_lattice[0], d.force_lattice[1]);
+    println!("collision       {:?}{}", s.lbm.collision, s.lbm.smagorinsky.map_or(String::new(), |c| format!(" + Smagorinsky C = {c}")));
+    if let Some(r) = d.mrt {
+        println!("MRT rates       s_e = {:.4}, s_eps = {:.4}, s_q = {:.4}, s_nu = {:.4}", r.s_e, r.s_eps, r.s_q, 1.0 / d.tau);
+    }
+    println!("precision       {:?}", s.lbm.precision);
+    println!("memory          {:.1} MiB (populations)", d.memory_bytes as f64 / (1 << 20) as f64);
+    println!("obstacles       {}", s.obstacles.len());
+    println!("ok");
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run(path: &PathBuf, out: &PathBuf) -> Result<ExitCode> {
+    let s = Scenario::from_file(path)?;
+    let d = s.derive()?;
+    eprintln!(
+        "{}: {} × {} cells, τ = {:.4}, Mach {:.3}, Re {:.1}, {} steps -> {}",
+        s.name, d.cells[0], d.cells[1], d.tau, d.mach, d.reynolds, d.steps, out.display()
+    );
+    let summary = if std::io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(d.steps);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} steps, eta {eta}")
+                .expect("valid template"),
+        );
+        let r = granflow::run::run(&s, out, &mut |i, _| bar.set_position(i));
+        bar.finish();
+        r
+    } else {
+        let mut last = 0;
+        granflow::run::run(&s, out, &mut |i, n| {
+            let pct = i * 10 / n.max(1);
+            if pct > last {
+                last = pct;
+                eprintln!("step {i}/{n} ({}%)", pct * 10);
+            }
+        })
+    }
+    .with_context(|| format!("run of {} stopped; frames written so far are in {}", path.display(), out.display()))?;
+    println!(
+        "done: {} steps, {:.1} s simulated, {} frames, {:.1} s wall, {:.1} MLUPS, mass drift {:.2e}",
+        summary.steps, summary.time, summary.frames, summary.wall_seconds, summary.mlups, summary.mass_drift
+    );
+    for o in &summary.obstacles {
+        println!(
+            "  {}: F = ({:.6e}, {:.6e}) N/m, coefficients ({:.4}, {:.4}){}",
+            o.name,
+            o.force[0],
+            o.force[1],
+            o.coefficients[0],
+            o.coefficients[1],
+            o.strouhal.map_or(String::new(), |st| format!(", St = {st:.4}"))
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_check(c: &Check, json: bool) {
+    if json {
+        println!("{}", serde_json::to_string(c).expect("checks serialise"));
+    } else {
+        println!(
+            "{:<5} {:<16} {:<60} value {:>12.6e}  reference {:>12.6e}  tolerance {:.3e}",
+            if c.pass { "PASS" } else { "FAIL" },
+            c.case,
+            c.quantity,
+            c.value,
+            c.reference,
+            c.tolerance
+        );
+    }
+}
+
+fn validate_cmd(case: &str, json: bool, full: bool) -> Result<ExitCode> {
+    if case == "list" {
+        for c in validate::CASES {
+            println!("{:<16} {}", c.name, c.description);
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let fidelity = if full { Fidelity::Full } else { Fidelity::Test };
+    let names: Vec<&str> = if case == "all" { validate::CASES.iter().map(|c| c.name).collect() } else { vec![case] };
+    let mut failed = 0;
+    for name in names {
+        match validate::run(name, fidelity) {
+            Ok(checks) => {
+                for c in &checks {
+                    print_check(c, json);
+                    failed += usize::from(!c.pass);
+                }
+            }
+            Err(e) => {
+                failed += 1;
+                if json {
+                    println!("{}", serde_json::json!({"case": name, "error": e.to_string(), "pass": false}));
+                } else {
+                    println!("ERROR {name}: {e}");
+                }
+            }
+        }
+    }
+    Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+}
+
+fn bench(which: Bench) -> Result<ExitCode> {
+    match which {
+        Bench::Lbm { nx, ny, steps, precision, collision, threads, repeats, json } => {
+            let r = granflow::bench::lbm(
+                nx,
+                ny,
+                steps,
+                matches!(precision, Precision::F64),
+                matches!(collision, Collision::Mrt),
+                threads,
+                repeats,
+            )?;
+            if json {
+                println!("{}", serde_json::to_string(&r)?);
+            } else {
+                println!(
+                    "lbm {}×{} {} {} on {} threads: {:.1} MLUPS (samples {:?}); copy {:.1} GB/s; {} B/cell; {:.0} % of roofline",
+                    r.nx, r.ny, r.precision, r.collision, r.threads, r.mlups, r.samples.iter().map(|s| (s * 10.0).round() / 10.0).collect::<Vec<_>>(), r.copy_gb_s, r.bytes_per_cell, 100.0 * r.roofline_fraction
+                );
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}

@@ -24,7 +24,7 @@
 //! is local: S_ij = −Π_ij^neq / (2ρ c_s² τ*), with Π^neq = Σ e_i e_i (f_i − f_i^eq). Solving
 //! τ* = τ + 3ν_t for τ* gives τ* = ½ [τ + √(τ² + 18 C² |Π^neq| / ρ)], |Π| = √(Π_ij Π_ij).
 
-use super::d2q9::{CX, CY, Q, W};
+use super::d2q9::{Q, W};
 use super::real::Real;
 
 /// Relaxation rates of the non-hydrodynamic MRT moments (s_ν comes from τ).
@@ -131,12 +131,10 @@ impl<T: Real> Collider<T> {
         let (half, one, three, c45, c15, nine) =
             (T::c(0.5), T::one(), T::c(3.0), T::c(4.5), T::c(1.5), T::c(9.0));
         let third = T::c(1.0 / 3.0);
-        let w: [T; Q] = std::array::from_fn(|i| T::c(W[i]));
-        let cx: [T; Q] = std::array::from_fn(|i| T::c(CX[i] as f64));
-        let cy: [T; Q] = std::array::from_fn(|i| T::c(CY[i] as f64));
+        let w = [T::c(W[0]), T::c(W[1]), T::c(W[5])];
         let (fx, fy) = (self.fx, self.fy);
         for l in 0..L {
-            let g: [T; Q] = std::array::from_fn(|i| f[i][l]);
+            let g: [T; Q] = [f[0][l], f[1][l], f[2][l], f[3][l], f[4][l], f[5][l], f[6][l], f[7][l], f[8][l]];
             let rho = g[0] + g[1] + g[2] + g[3] + g[4] + g[5] + g[6] + g[7] + g[8];
             let jx = g[1] - g[3] + g[5] - g[6] - g[7] + g[8];
             let jy = g[2] - g[4] + g[5] + g[6] - g[7] - g[8];
@@ -154,13 +152,18 @@ impl<T: Real> Collider<T> {
             let usq = c15 * (ux * ux + uy * uy);
             let uf = ux * fx + uy * fy;
             let fk = one - half * omega;
-            for i in 0..Q {
-                let cu = cx[i] * ux + cy[i] * uy;
-                let cf = cx[i] * fx + cy[i] * fy;
-                let feq = w[i] * rho * (one + three * cu + c45 * cu * cu - usq);
-                let src = fk * w[i] * (three * (cf - uf) + nine * cu * cf);
-                f[i][l] = g[i] + omega * (feq - g[i]) + src;
+            // e_i·u and e_i·F for i = 0..8, written out so the lane loop is straight-line code.
+            let zero = T::zero();
+            let cu = [zero, ux, uy, -ux, -uy, ux + uy, uy - ux, -ux - uy, ux - uy];
+            let cf = [zero, fx, fy, -fx, -fy, fx + fy, fy - fx, -fx - fy, fx - fy];
+            macro_rules! relax {
+                ($($i:literal $k:literal),*) => {$(
+                    let feq = w[$k] * rho * (one + three * cu[$i] + c45 * cu[$i] * cu[$i] - usq);
+                    let src = fk * w[$k] * (three * (cf[$i] - uf) + nine * cu[$i] * cf[$i]);
+                    f[$i][l] = g[$i] + omega * (feq - g[$i]) + src;
+                )*};
             }
+            relax!(0 0, 1 1, 2 1, 3 1, 4 1, 5 2, 6 2, 7 2, 8 2);
         }
     }
 
@@ -247,10 +250,11 @@ impl<T: Real> Collider<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lbm::d2q9::{equilibrium, moments};
+    use crate::lbm::d2q9::{equilibrium, moments, CX, CY};
     use approx::assert_relative_eq;
 
-    /// The D2Q9 moment matrix M of seed eq. 5.20.
+    /// The D2Q9 moment matrix M (Lallemand & Luo 2000). Seed eq. 5.20 prints the last row
+    /// (p_xy) as (0 0 0 0 0 1 1 1 1); the correct row is e_x e_y = (0 0 0 0 0 1 −1 1 −1).
     const M: [[f64; Q]; Q] = [
         [1., 1., 1., 1., 1., 1., 1., 1., 1.],
         [-4., -1., -1., -1., -1., 2., 2., 2., 2.],
@@ -260,7 +264,7 @@ mod tests {
         [0., 0., 1., 0., -1., 1., 1., -1., -1.],
         [0., 0., -2., 0., 2., 1., 1., -1., -1.],
         [0., 1., -1., 1., -1., 0., 0., 0., 0.],
-        [0., 0., 0., 0., 0., 1., 1., 1., 1.],
+        [0., 0., 0., 0., 0., 1., -1., 1., -1.],
     ];
 
     fn mul(f: &[f64; Q]) -> [f64; Q] {

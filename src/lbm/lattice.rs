@@ -385,10 +385,25 @@ unsafe fn bulk_run<T: Real>(
     });
     let mut x = x0;
     let mut buf = [[T::zero(); LANES]; Q];
-    while x < x1 {
-        let len = LANES.min(x1 - x);
+    // Full chunks: fixed-size loads and stores the compiler turns into vector moves.
+    while x + LANES <= x1 {
         for i in 0..Q {
             // Even: f_i = A[x][i]. Odd: slot of direction i holds f_ī.
+            let dst = if even { i } else { OPP[i] };
+            buf[dst] = std::ptr::read_unaligned(f.add(offs[i] + x) as *const [T; LANES]);
+        }
+        collider.collide(&mut buf);
+        for i in 0..Q {
+            // Even: A[x][ī] = f_i*. Odd: A[x + e_i][i] = f_i*.
+            let slot = if even { OPP[i] } else { i };
+            std::ptr::write_unaligned(f.add(offs[slot] + x) as *mut [T; LANES], buf[i]);
+        }
+        x += LANES;
+    }
+    // Remainder, padded with copies of its first cell.
+    if x < x1 {
+        let len = x1 - x;
+        for i in 0..Q {
             let dst = if even { i } else { OPP[i] };
             std::ptr::copy_nonoverlapping(f.add(offs[i] + x), buf[dst].as_mut_ptr(), len);
             for l in len..LANES {
@@ -397,11 +412,9 @@ unsafe fn bulk_run<T: Real>(
         }
         collider.collide(&mut buf);
         for i in 0..Q {
-            // Even: A[x][ī] = f_i*. Odd: A[x + e_i][i] = f_i*.
             let slot = if even { OPP[i] } else { i };
             std::ptr::copy_nonoverlapping(buf[i].as_ptr(), f.add(offs[slot] + x), len);
         }
-        x += len;
     }
 }
 

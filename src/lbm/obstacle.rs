@@ -166,6 +166,11 @@ pub struct Obstacles {
 }
 
 impl Obstacles {
+    /// A set of obstacles, not yet linked to a lattice.
+    pub fn new(list: Vec<Obstacle>) -> Self {
+        Obstacles { list, ..Default::default() }
+    }
+
     /// Rasterise: the solid mask (`solid[y·nx + x]`) of the obstacles on an `nx × ny` lattice.
     pub fn mask(&self, nx: usize, ny: usize) -> Vec<bool> {
         let mut solid = vec![false; nx * ny];

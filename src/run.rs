@@ -82,7 +82,8 @@ pub fn run(scenario: &Scenario, out: &Path, progress: Progress) -> Result<Summar
     let total = derived.steps;
     let mut result = Ok(());
     let mut macro_ = Macroscopic::default();
-    state.record(fluid.as_ref(), &mut macro_, true)?;
+    state.row(fluid.as_ref(), &mut macro_)?;
+    state.write_frame(&macro_, 0.0)?;
     let mut lift = Vec::new();
     while fluid.step_count() < total {
         let s = fluid.step_count();
@@ -101,13 +102,16 @@ pub fn run(scenario: &Scenario, out: &Path, progress: Progress) -> Result<Summar
             result = Err(e);
             break;
         }
+        let frame = s % derived.frame_every == 0 || s == total;
         if s % derived.series_every == 0 || s == total {
-            state.record(fluid.as_ref(), &mut macro_, s % derived.frame_every == 0 || s == total)?;
+            state.row(fluid.as_ref(), &mut macro_)?;
             if s * 2 >= total {
                 lift.push(fluid.obstacle_loads().0.first().map_or(0.0, |f| f[1]));
             }
-        } else if s % derived.frame_every == 0 {
-            state.record(fluid.as_ref(), &mut macro_, true)?;
+        }
+        if frame {
+            fluid.macroscopic(&mut macro_);
+            state.write_frame(&macro_, s as f64 * derived.units.dt)?;
         }
         progress(s, total);
     }
@@ -194,8 +198,8 @@ impl Outputs {
         })
     }
 
-    /// Append a time-series row and, if `frame`, write a VTK frame.
-    fn record(&mut self, fluid: &dyn Fluid, m: &mut Macroscopic, frame: bool) -> Result<()> {
+    /// Append a time-series row; leaves the macroscopic fields in `m`.
+    fn row(&mut self, fluid: &dyn Fluid, m: &mut Macroscopic) -> Result<()> {
         let u = self.derived.units;
         fluid.macroscopic(m);
         let t = fluid.step_count() as f64 * u.dt;
@@ -223,11 +227,7 @@ impl Outputs {
         for &c in &self.probes {
             row.extend([u.pressure_to_si(m.rho[c]), m.ux[c] * v, m.uy[c] * v]);
         }
-        self.series.row(&row)?;
-        if frame {
-            self.write_frame(m, t)?;
-        }
-        Ok(())
+        self.series.row(&row)
     }
 
     fn write_frame(&mut self, m: &Macroscopic, t: f64) -> Result<()> {

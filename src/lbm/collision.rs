@@ -105,11 +105,16 @@ impl<T: Real> Collider<T> {
     /// Collide `L` cells in place.
     #[inline(always)]
     pub fn collide<const L: usize>(&self, f: &mut [[T; L]; Q]) {
-        match (self.model, self.smagorinsky.is_some()) {
-            (CollisionModel::Bgk, false) => self.bgk::<L, false>(f),
-            (CollisionModel::Bgk, true) => self.bgk::<L, true>(f),
-            (CollisionModel::Mrt(_), false) => self.mrt::<L, false>(f),
-            (CollisionModel::Mrt(_), true) => self.mrt::<L, true>(f),
+        let forced = self.force != [0.0, 0.0];
+        match (self.model, self.smagorinsky.is_some(), forced) {
+            (CollisionModel::Bgk, false, false) => self.bgk::<L, false, false>(f),
+            (CollisionModel::Bgk, false, true) => self.bgk::<L, false, true>(f),
+            (CollisionModel::Bgk, true, false) => self.bgk::<L, true, false>(f),
+            (CollisionModel::Bgk, true, true) => self.bgk::<L, true, true>(f),
+            (CollisionModel::Mrt(_), false, false) => self.mrt::<L, false, false>(f),
+            (CollisionModel::Mrt(_), false, true) => self.mrt::<L, false, true>(f),
+            (CollisionModel::Mrt(_), true, false) => self.mrt::<L, true, false>(f),
+            (CollisionModel::Mrt(_), true, true) => self.mrt::<L, true, true>(f),
         }
     }
 
@@ -126,21 +131,22 @@ impl<T: Real> Collider<T> {
         }
     }
 
+    /// BGK on `L` lanes. Opposite directions share the even part of the equilibrium,
+    /// f_i^eq = w_i ρ (1 − 1.5|u|² + 4.5 (e_i·u)²) ± 3 w_i ρ e_i·u, which halves the work.
     #[inline(always)]
-    fn bgk<const L: usize, const LES: bool>(&self, f: &mut [[T; L]; Q]) {
+    fn bgk<const L: usize, const LES: bool, const FORCE: bool>(&self, f: &mut [[T; L]; Q]) {
         let (half, one, three, c45, c15, nine) =
             (T::c(0.5), T::one(), T::c(3.0), T::c(4.5), T::c(1.5), T::c(9.0));
         let third = T::c(1.0 / 3.0);
-        let w = [T::c(W[0]), T::c(W[1]), T::c(W[5])];
-        let (fx, fy) = (self.fx, self.fy);
+        let (w0, w1, w5) = (T::c(W[0]), T::c(W[1]), T::c(W[5]));
+        let (fx, fy) = if FORCE { (self.fx, self.fy) } else { (T::zero(), T::zero()) };
         for l in 0..L {
             let g: [T; Q] = [f[0][l], f[1][l], f[2][l], f[3][l], f[4][l], f[5][l], f[6][l], f[7][l], f[8][l]];
             let rho = g[0] + g[1] + g[2] + g[3] + g[4] + g[5] + g[6] + g[7] + g[8];
             let jx = g[1] - g[3] + g[5] - g[6] - g[7] + g[8];
             let jy = g[2] - g[4] + g[5] + g[6] - g[7] - g[8];
             let inv = one / rho;
-            let ux = (jx + half * fx) * inv;
-            let uy = (jy + half * fy) * inv;
+            let (ux, uy) = if FORCE { ((jx + half * fx) * inv, (jy + half * fy) * inv) } else { (jx * inv, jy * inv) };
             let omega = if LES {
                 let pxx = g[1] + g[3] + g[5] + g[6] + g[7] + g[8] - rho * (third + ux * ux);
                 let pyy = g[2] + g[4] + g[5] + g[6] + g[7] + g[8] - rho * (third + uy * uy);
@@ -149,30 +155,48 @@ impl<T: Real> Collider<T> {
             } else {
                 self.omega
             };
-            let usq = c15 * (ux * ux + uy * uy);
-            let uf = ux * fx + uy * fy;
-            let fk = one - half * omega;
-            // e_i·u and e_i·F for i = 0..8, written out so the lane loop is straight-line code.
-            let zero = T::zero();
-            let cu = [zero, ux, uy, -ux, -uy, ux + uy, uy - ux, -ux - uy, ux - uy];
-            let cf = [zero, fx, fy, -fx, -fy, fx + fy, fy - fx, -fx - fy, fx - fy];
-            macro_rules! relax {
-                ($($i:literal $k:literal),*) => {$(
-                    let feq = w[$k] * rho * (one + three * cu[$i] + c45 * cu[$i] * cu[$i] - usq);
-                    let src = fk * w[$k] * (three * (cf[$i] - uf) + nine * cu[$i] * cf[$i]);
-                    f[$i][l] = g[$i] + omega * (feq - g[$i]) + src;
-                )*};
+            let keep = one - omega;
+            let base = one - c15 * (ux * ux + uy * uy);
+            // ω w_i ρ for the three weight classes.
+            let (r0, r1, r5) = (omega * w0 * rho, omega * w1 * rho, omega * w5 * rho);
+            f[0][l] = keep * g[0] + r0 * base;
+            // (i, ī, e_i·u, ω w ρ) for the four opposite pairs.
+            macro_rules! pair {
+                ($i:literal, $o:literal, $cu:expr, $r:expr) => {{
+                    let cu = $cu;
+                    let even = $r * (base + c45 * cu * cu);
+                    let odd = $r * three * cu;
+                    f[$i][l] = keep * g[$i] + (even + odd);
+                    f[$o][l] = keep * g[$o] + (even - odd);
+                }};
             }
-            relax!(0 0, 1 1, 2 1, 3 1, 4 1, 5 2, 6 2, 7 2, 8 2);
+            pair!(1, 3, ux, r1);
+            pair!(2, 4, uy, r1);
+            pair!(5, 7, ux + uy, r5);
+            pair!(6, 8, uy - ux, r5);
+            if FORCE {
+                // Guo: (1 − ω/2) w_i [3(e_i − u)·F + 9(e_i·u)(e_i·F)].
+                let fk = one - half * omega;
+                let uf = ux * fx + uy * fy;
+                let cu = [T::zero(), ux, uy, -ux, -uy, ux + uy, uy - ux, -ux - uy, ux - uy];
+                let cf = [T::zero(), fx, fy, -fx, -fy, fx + fy, fy - fx, -fx - fy, fx - fy];
+                let w = [w0, w1, w1, w1, w1, w5, w5, w5, w5];
+                macro_rules! guo {
+                    ($($i:literal),*) => {$(
+                        f[$i][l] = f[$i][l] + fk * w[$i] * (three * (cf[$i] - uf) + nine * cu[$i] * cf[$i]);
+                    )*};
+                }
+                guo!(0, 1, 2, 3, 4, 5, 6, 7, 8);
+            }
         }
     }
 
     #[inline(always)]
-    fn mrt<const L: usize, const LES: bool>(&self, f: &mut [[T; L]; Q]) {
+    fn mrt<const L: usize, const LES: bool, const FORCE: bool>(&self, f: &mut [[T; L]; Q]) {
         let (half, one, two, three, four, six) =
             (T::c(0.5), T::one(), T::c(2.0), T::c(3.0), T::c(4.0), T::c(6.0));
         let [s_e, s_eps, s_q] = self.s;
-        let (fx, fy) = (self.fx, self.fy);
+        let (fx, fy) = if FORCE { (self.fx, self.fy) } else { (T::zero(), T::zero()) };
         let (i9, i36, i6, i12, i4) = (
             T::c(1.0 / 9.0),
             T::c(1.0 / 36.0),
@@ -195,10 +219,8 @@ impl<T: Real> Collider<T> {
             let pxy = g[5] - g[6] + g[7] - g[8];
 
             let inv = one / rho;
-            let ux = (jx + half * fx) * inv;
-            let uy = (jy + half * fy) * inv;
+            let (ux, uy) = if FORCE { ((jx + half * fx) * inv, (jy + half * fy) * inv) } else { (jx * inv, jy * inv) };
             let u2 = ux * ux + uy * uy;
-            let uf = ux * fx + uy * fy;
             // Non-equilibrium parts of the moments.
             let e_n = e - rho * (three * u2 - two);
             let eps_n = eps - rho * (one - three * u2);
@@ -213,15 +235,25 @@ impl<T: Real> Collider<T> {
             } else {
                 self.omega
             };
-            // Post-collision moments with the forcing moments M G.
-            let e = e - s_e * e_n + (one - half * s_e) * six * uf;
-            let eps = eps - s_eps * eps_n - (one - half * s_eps) * six * uf;
-            let jx = jx + fx;
-            let jy = jy + fy;
-            let qx = qx - s_q * qx_n - (one - half * s_q) * fx;
-            let qy = qy - s_q * qy_n - (one - half * s_q) * fy;
-            let pxx = pxx - s_nu * pxx_n + (one - half * s_nu) * two * (ux * fx - uy * fy);
-            let pxy = pxy - s_nu * pxy_n + (one - half * s_nu) * (ux * fy + uy * fx);
+            // Post-collision moments, plus the forcing moments M G when forced.
+            let mut e = e - s_e * e_n;
+            let mut eps = eps - s_eps * eps_n;
+            let mut qx = qx - s_q * qx_n;
+            let mut qy = qy - s_q * qy_n;
+            let mut pxx = pxx - s_nu * pxx_n;
+            let mut pxy = pxy - s_nu * pxy_n;
+            let (mut jx, mut jy) = (jx, jy);
+            if FORCE {
+                let uf = ux * fx + uy * fy;
+                e = e + (one - half * s_e) * six * uf;
+                eps = eps - (one - half * s_eps) * six * uf;
+                jx = jx + fx;
+                jy = jy + fy;
+                qx = qx - (one - half * s_q) * fx;
+                qy = qy - (one - half * s_q) * fy;
+                pxx = pxx + (one - half * s_nu) * two * (ux * fx - uy * fy);
+                pxy = pxy + (one - half * s_nu) * (ux * fy + uy * fx);
+            }
             // f = M⁻¹ m = Mᵀ diag(1/9, 1/36, 1/36, 1/6, 1/12, 1/6, 1/12, 1/4, 1/4) m.
             let a = rho * i9;
             let b = e * i36;

@@ -1,0 +1,27 @@
+//! `cargo bench --bench lbm`: D2Q9 throughput for both precisions and collision operators,
+//! each beside the measured copy bandwidth (the same measurement as `granflow bench lbm`).
+//! Size and steps: `GRANFLOW_BENCH_N` (default 1024), `GRANFLOW_BENCH_STEPS` (default 50).
+
+fn env(name: &str, default: usize) -> usize {
+    std::env::var(name).ok().and_then(|v| v.parse().ok()).unwrap_or(default)
+}
+
+fn main() {
+    let n = env("GRANFLOW_BENCH_N", 1024);
+    let steps = env("GRANFLOW_BENCH_STEPS", 50) as u64;
+    for f64_ in [false, true] {
+        for mrt in [false, true] {
+            match granflow::bench::lbm(n, n, steps, f64_, mrt, 0, 5) {
+                Ok(r) => println!(
+                    "lbm {n}² {} {}: {:.1} MLUPS, copy {:.1} GB/s, {:.0} % of roofline",
+                    r.precision,
+                    r.collision,
+                    r.mlups,
+                    r.copy_gb_s,
+                    100.0 * r.roofline_fraction
+                ),
+                Err(e) => eprintln!("lbm bench failed: {e}"),
+            }
+        }
+    }
+}

@@ -15,6 +15,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use crate::analysis::spectrum::dominant_frequency;
 use crate::config::{Derived, Scenario};
 use crate::io::{write_json, write_vti, CsvWriter, Field, ImageGrid, PvdSeries};
 use crate::lbm::{Fluid, Macroscopic};
@@ -38,7 +39,7 @@ pub struct ObstacleSummary {
     /// Force coefficients 2F/(ρU²L) with the reference U and L.
     pub coefficients: [f64; 2],
     /// Strouhal number f L/U of the lift (y-force) history over the second half of the run,
-    /// if it oscillates.
+    /// by FFT ([`dominant_frequency`]), if the lift oscillates by more than 1 % of the force.
     pub strouhal: Option<f64>,
 }
 
@@ -132,8 +133,10 @@ pub fn run(scenario: &Scenario, out: &Path, progress: Progress) -> Result<Summar
                 force: f,
                 torque: u.torque_to_si(torques[k]),
                 coefficients: [f[0] / q, f[1] / q],
-                // TODO(spectrum): St from crate::analysis::spectrum once it lands.
-                strouhal: (k == 0 && series_dt > 0.0 && lift.len() > usize::MAX).then_some(0.0),
+                strouhal: (k == 0 && oscillates(&lift, forces[k][0].hypot(forces[k][1])))
+                    .then(|| dominant_frequency(&lift, series_dt))
+                    .flatten()
+                    .map(|freq| freq * lref / uref),
             }
         })
         .collect();
@@ -154,6 +157,13 @@ pub fn run(scenario: &Scenario, out: &Path, progress: Progress) -> Result<Summar
     };
     write_json(&out.join("summary.json"), &summary)?;
     result.map(|()| summary)
+}
+
+/// Does a lift history oscillate? Peak-to-peak above 1 % of the force magnitude `scale`, so
+/// that a steady wake's round-off is not reported as a shedding frequency.
+fn oscillates(lift: &[f64], scale: f64) -> bool {
+    let (lo, hi) = lift.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    lift.len() >= 8 && hi - lo > 0.01 * scale
 }
 
 fn next_multiple(s: u64, every: u64) -> u64 {

@@ -1,0 +1,3 @@
+//! Post-processing: spectral analysis of time series (shedding frequencies).
+
+pub mod spectrum;

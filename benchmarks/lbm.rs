@@ -3,7 +3,10 @@
 //! Size and steps: `GRANFLOW_BENCH_N` (default 1024), `GRANFLOW_BENCH_STEPS` (default 50).
 
 fn env(name: &str, default: usize) -> usize {
-    std::env::var(name).ok().and_then(|v| v.parse().ok()).unwrap_or(default)
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
 }
 
 fn main() {

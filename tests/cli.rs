@@ -8,13 +8,23 @@ fn granflow() -> Command {
 }
 
 fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
 }
 
 #[test]
 fn check_prints_derived_quantities() {
-    let out = granflow().arg("check").arg(data("tiny_channel.toml")).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = granflow()
+        .arg("check")
+        .arg(data("tiny_channel.toml"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8_lossy(&out.stdout);
     for key in ["tau", "Mach", "Reynolds", "cells", "steps", "memory"] {
         assert!(text.contains(key), "missing {key} in:\n{text}");
@@ -33,25 +43,47 @@ fn run_writes_a_complete_series() {
         .arg(dir.path())
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     // 40 s at a 10 s frame interval: frames at 0, 10, 20, 30, 40 s.
     for k in 0..5 {
-        assert!(dir.path().join(format!("fluid_{k:06}.vti")).exists(), "frame {k}");
+        assert!(
+            dir.path().join(format!("fluid_{k:06}.vti")).exists(),
+            "frame {k}"
+        );
     }
     let pvd = std::fs::read_to_string(dir.path().join("series.pvd")).unwrap();
     assert_eq!(pvd.matches("<DataSet").count(), 5, "{pvd}");
     let csv = std::fs::read_to_string(dir.path().join("timeseries.csv")).unwrap();
     let header = csv.lines().next().unwrap();
-    assert!(header.contains("post_fx") && header.contains("upstream_p"), "{header}");
+    assert!(
+        header.contains("post_fx") && header.contains("upstream_p"),
+        "{header}"
+    );
     // A row every 51 steps (2 s rounded to whole steps of 0.039 s) and one at the end, 40 s.
     assert_eq!(csv.lines().count(), 1 + 21 + 1, "{csv}");
-    let last_t: f64 = csv.lines().last().unwrap().split(',').next().unwrap().parse().unwrap();
+    let last_t: f64 = csv
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
     assert!((last_t - 40.0).abs() < 1e-9, "{last_t}");
     let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap()).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
     assert_eq!(summary["status"], "completed");
     // The flow pushes the post downstream.
-    assert!(summary["obstacles"][0]["force"][0].as_f64().unwrap() > 0.0, "{summary}");
+    assert!(
+        summary["obstacles"][0]["force"][0].as_f64().unwrap() > 0.0,
+        "{summary}"
+    );
     // No temporary files left behind.
     for e in std::fs::read_dir(dir.path()).unwrap() {
         let name = e.unwrap().file_name().into_string().unwrap();
@@ -66,17 +98,32 @@ fn an_unstable_run_stops_naming_step_and_cell_and_keeps_its_frames() {
     // past Mach 0.5 and the run must stop.
     let text = std::fs::read_to_string(data("tiny_channel.toml"))
         .unwrap()
-        .replace("body_acceleration = [8.0e-6, 0.0]", "body_acceleration = [0.05, 0.0]")
-        .replace("bottom = { type = \"wall\" }", "bottom = { type = \"periodic\" }")
+        .replace(
+            "body_acceleration = [8.0e-6, 0.0]",
+            "body_acceleration = [0.05, 0.0]",
+        )
+        .replace(
+            "bottom = { type = \"wall\" }",
+            "bottom = { type = \"periodic\" }",
+        )
         .replace("top = { type = \"wall\" }", "top = { type = \"periodic\" }")
         .replace("end = 40.0", "end = 400.0");
     let scenario = dir.path().join("unstable.toml");
     std::fs::write(&scenario, text).unwrap();
     let out_dir = dir.path().join("out");
-    let out = granflow().arg("run").arg(&scenario).arg("--out").arg(&out_dir).output().unwrap();
+    let out = granflow()
+        .arg("run")
+        .arg(&scenario)
+        .arg("--out")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("unstable at step") && err.contains("cell ("), "{err}");
+    assert!(
+        err.contains("unstable at step") && err.contains("cell ("),
+        "{err}"
+    );
     assert!(out_dir.join("fluid_000000.vti").exists());
     let summary = std::fs::read_to_string(out_dir.join("summary.json")).unwrap();
     assert!(summary.contains("unstable at step"), "{summary}");
@@ -97,15 +144,47 @@ fn check_error(edit: impl Fn(String) -> String, expect: &[&str]) {
 
 #[test]
 fn bad_input_names_the_field_and_the_reason() {
-    check_error(|t| t.replace("tau = 0.8", "tau = 0.5"), &["time.tau", "must exceed"]);
-    check_error(|t| t.replace("viscosity = 1.0e-6", "viscosity = -1.0e-6"), &["fluid.viscosity", "positive"]);
-    check_error(|t| t.replace("velocity = 1.0e-4\n", "velocity = 1.0\n"), &["reference.velocity", "Mach"]);
-    check_error(|t| t.replace("center = [0.0025, 0.005]", "center = [0.0045, 0.005]"), &["obstacles[0].center", "outside"]);
-    check_error(|t| t.replace("size = [0.005, 0.01]", "size = [0.0051, 0.01]"), &["domain.size[0]", "whole number"]);
-    check_error(|t| t.replace("tau = 0.8", "tau = 0.8\ndt = 0.01"), &["time", "exactly one"]);
-    check_error(|t| t.replace("right = { type = \"periodic\" }", "right = { type = \"wall\" }"), &["boundaries.left/right", "periodic"]);
+    check_error(
+        |t| t.replace("tau = 0.8", "tau = 0.5"),
+        &["time.tau", "must exceed"],
+    );
+    check_error(
+        |t| t.replace("viscosity = 1.0e-6", "viscosity = -1.0e-6"),
+        &["fluid.viscosity", "positive"],
+    );
+    check_error(
+        |t| t.replace("velocity = 1.0e-4\n", "velocity = 1.0\n"),
+        &["reference.velocity", "Mach"],
+    );
+    check_error(
+        |t| t.replace("center = [0.0025, 0.005]", "center = [0.0045, 0.005]"),
+        &["obstacles[0].center", "outside"],
+    );
+    check_error(
+        |t| t.replace("size = [0.005, 0.01]", "size = [0.0051, 0.01]"),
+        &["domain.size[0]", "whole number"],
+    );
+    check_error(
+        |t| t.replace("tau = 0.8", "tau = 0.8\ndt = 0.01"),
+        &["time", "exactly one"],
+    );
+    check_error(
+        |t| {
+            t.replace(
+                "right = { type = \"periodic\" }",
+                "right = { type = \"wall\" }",
+            )
+        },
+        &["boundaries.left/right", "periodic"],
+    );
     // Unknown and missing keys are refused by the parser, naming the key.
-    check_error(|t| t.replace("viscosity = 1.0e-6", "viscosity = 1.0e-6\nviscosty = 2.0"), &["viscosty"]);
+    check_error(
+        |t| t.replace("viscosity = 1.0e-6", "viscosity = 1.0e-6\nviscosty = 2.0"),
+        &["viscosty"],
+    );
     check_error(|t| t.replace("density = 1000.0\n", ""), &["density"]);
-    check_error(|t| t.replace("collision = \"mrt\"", "collision = \"trt\""), &["trt"]);
+    check_error(
+        |t| t.replace("collision = \"mrt\"", "collision = \"trt\""),
+        &["trt"],
+    );
 }

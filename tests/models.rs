@@ -18,10 +18,14 @@ fn toml_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
 #[test]
 fn every_model_file_parses_and_checks() {
     let mut files = Vec::new();
-    toml_files(&Path::new(env!("CARGO_MANIFEST_DIR")).join("models/lbm"), &mut files);
+    toml_files(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("models/lbm"),
+        &mut files,
+    );
     assert!(!files.is_empty());
     for f in files {
         let s = Scenario::from_file(&f).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
-        s.derive().unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        s.derive()
+            .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
     }
 }

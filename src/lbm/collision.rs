@@ -124,7 +124,8 @@ impl<T: Real> Collider<T> {
         if LES {
             let two = T::c(2.0);
             let pi = (pxx * pxx + pyy * pyy + two * pxy * pxy).sqrt();
-            let tau = T::c(0.5) * (self.tau_t + (self.tau_t * self.tau_t + self.les_k * pi / rho).sqrt());
+            let tau =
+                T::c(0.5) * (self.tau_t + (self.tau_t * self.tau_t + self.les_k * pi / rho).sqrt());
             T::one() / tau
         } else {
             self.omega
@@ -135,18 +136,34 @@ impl<T: Real> Collider<T> {
     /// f_i^eq = w_i ρ (1 − 1.5|u|² + 4.5 (e_i·u)²) ± 3 w_i ρ e_i·u, which halves the work.
     #[inline(always)]
     fn bgk<const L: usize, const LES: bool, const FORCE: bool>(&self, f: &mut [[T; L]; Q]) {
-        let (half, one, three, c45, c15, nine) =
-            (T::c(0.5), T::one(), T::c(3.0), T::c(4.5), T::c(1.5), T::c(9.0));
+        let (half, one, three, c45, c15, nine) = (
+            T::c(0.5),
+            T::one(),
+            T::c(3.0),
+            T::c(4.5),
+            T::c(1.5),
+            T::c(9.0),
+        );
         let third = T::c(1.0 / 3.0);
         let (w0, w1, w5) = (T::c(W[0]), T::c(W[1]), T::c(W[5]));
-        let (fx, fy) = if FORCE { (self.fx, self.fy) } else { (T::zero(), T::zero()) };
+        let (fx, fy) = if FORCE {
+            (self.fx, self.fy)
+        } else {
+            (T::zero(), T::zero())
+        };
         for l in 0..L {
-            let g: [T; Q] = [f[0][l], f[1][l], f[2][l], f[3][l], f[4][l], f[5][l], f[6][l], f[7][l], f[8][l]];
+            let g: [T; Q] = [
+                f[0][l], f[1][l], f[2][l], f[3][l], f[4][l], f[5][l], f[6][l], f[7][l], f[8][l],
+            ];
             let rho = g[0] + g[1] + g[2] + g[3] + g[4] + g[5] + g[6] + g[7] + g[8];
             let jx = g[1] - g[3] + g[5] - g[6] - g[7] + g[8];
             let jy = g[2] - g[4] + g[5] + g[6] - g[7] - g[8];
             let inv = one / rho;
-            let (ux, uy) = if FORCE { ((jx + half * fx) * inv, (jy + half * fy) * inv) } else { (jx * inv, jy * inv) };
+            let (ux, uy) = if FORCE {
+                ((jx + half * fx) * inv, (jy + half * fy) * inv)
+            } else {
+                (jx * inv, jy * inv)
+            };
             let omega = if LES {
                 let pxx = g[1] + g[3] + g[5] + g[6] + g[7] + g[8] - rho * (third + ux * ux);
                 let pyy = g[2] + g[4] + g[5] + g[6] + g[7] + g[8] - rho * (third + uy * uy);
@@ -178,8 +195,28 @@ impl<T: Real> Collider<T> {
                 // Guo: (1 − ω/2) w_i [3(e_i − u)·F + 9(e_i·u)(e_i·F)].
                 let fk = one - half * omega;
                 let uf = ux * fx + uy * fy;
-                let cu = [T::zero(), ux, uy, -ux, -uy, ux + uy, uy - ux, -ux - uy, ux - uy];
-                let cf = [T::zero(), fx, fy, -fx, -fy, fx + fy, fy - fx, -fx - fy, fx - fy];
+                let cu = [
+                    T::zero(),
+                    ux,
+                    uy,
+                    -ux,
+                    -uy,
+                    ux + uy,
+                    uy - ux,
+                    -ux - uy,
+                    ux - uy,
+                ];
+                let cf = [
+                    T::zero(),
+                    fx,
+                    fy,
+                    -fx,
+                    -fy,
+                    fx + fy,
+                    fy - fx,
+                    -fx - fy,
+                    fx - fy,
+                ];
                 let w = [w0, w1, w1, w1, w1, w5, w5, w5, w5];
                 macro_rules! guo {
                     ($($i:literal),*) => {$(
@@ -194,10 +231,20 @@ impl<T: Real> Collider<T> {
 
     #[inline(always)]
     fn mrt<const L: usize, const LES: bool, const FORCE: bool>(&self, f: &mut [[T; L]; Q]) {
-        let (half, one, two, three, four, six) =
-            (T::c(0.5), T::one(), T::c(2.0), T::c(3.0), T::c(4.0), T::c(6.0));
+        let (half, one, two, three, four, six) = (
+            T::c(0.5),
+            T::one(),
+            T::c(2.0),
+            T::c(3.0),
+            T::c(4.0),
+            T::c(6.0),
+        );
         let [s_e, s_eps, s_q] = self.s;
-        let (fx, fy) = if FORCE { (self.fx, self.fy) } else { (T::zero(), T::zero()) };
+        let (fx, fy) = if FORCE {
+            (self.fx, self.fy)
+        } else {
+            (T::zero(), T::zero())
+        };
         let (i9, i36, i6, i12, i4) = (
             T::c(1.0 / 9.0),
             T::c(1.0 / 36.0),
@@ -220,7 +267,11 @@ impl<T: Real> Collider<T> {
             let pxy = g[5] - g[6] + g[7] - g[8];
 
             let inv = one / rho;
-            let (ux, uy) = if FORCE { ((jx + half * fx) * inv, (jy + half * fy) * inv) } else { (jx * inv, jy * inv) };
+            let (ux, uy) = if FORCE {
+                ((jx + half * fx) * inv, (jy + half * fy) * inv)
+            } else {
+                (jx * inv, jy * inv)
+            };
             let u2 = ux * ux + uy * uy;
             // Non-equilibrium parts of the moments.
             let e_n = e - rho * (three * u2 - two);
@@ -286,7 +337,8 @@ impl<T: Real> Collider<T> {
 /// to 1 + δ, δ ≈ −5.6e-17, which otherwise biases the mass by δ every step).
 #[inline(always)]
 fn rest_from_mass<T: Real, const L: usize>(rho: T, f: &[[T; L]; Q], l: usize) -> T {
-    rho - (((f[1][l] + f[2][l]) + (f[3][l] + f[4][l])) + ((f[5][l] + f[6][l]) + (f[7][l] + f[8][l])))
+    rho - (((f[1][l] + f[2][l]) + (f[3][l] + f[4][l]))
+        + ((f[5][l] + f[6][l]) + (f[7][l] + f[8][l])))
 }
 
 #[cfg(test)]
@@ -330,7 +382,12 @@ mod tests {
             rho * ux * uy,
         ];
         for r in 0..Q {
-            assert!((m[r] - expect[r]).abs() < 1e-14, "moment {r}: {} vs {}", m[r], expect[r]);
+            assert!(
+                (m[r] - expect[r]).abs() < 1e-14,
+                "moment {r}: {} vs {}",
+                m[r],
+                expect[r]
+            );
         }
     }
 
@@ -356,7 +413,12 @@ mod tests {
             ux * fy + uy * fx,
         ];
         for r in 0..Q {
-            assert!((m[r] - expect[r]).abs() < 1e-16, "moment {r}: {} vs {}", m[r], expect[r]);
+            assert!(
+                (m[r] - expect[r]).abs() < 1e-16,
+                "moment {r}: {} vs {}",
+                m[r],
+                expect[r]
+            );
         }
     }
 
@@ -372,7 +434,10 @@ mod tests {
     #[test]
     fn collision_conserves_mass_and_adds_the_force() {
         let force = [1e-4, -3e-4];
-        for model in [CollisionModel::Bgk, CollisionModel::Mrt(MrtRates::standard(0.8))] {
+        for model in [
+            CollisionModel::Bgk,
+            CollisionModel::Mrt(MrtRates::standard(0.8)),
+        ] {
             for les in [None, Some(0.1)] {
                 let f0 = perturbed();
                 let c = Collider::<f64>::new(model, 0.8, les, force);
@@ -392,7 +457,11 @@ mod tests {
     #[test]
     fn mrt_with_equal_rates_is_bgk() {
         let tau = 0.7;
-        let rates = MrtRates { s_e: 1.0 / tau, s_eps: 1.0 / tau, s_q: 1.0 / tau };
+        let rates = MrtRates {
+            s_e: 1.0 / tau,
+            s_eps: 1.0 / tau,
+            s_q: 1.0 / tau,
+        };
         let f0 = perturbed();
         let mut a: [[f64; 1]; Q] = std::array::from_fn(|i| [f0[i]]);
         let mut b = a;
@@ -407,7 +476,10 @@ mod tests {
     #[test]
     fn equilibrium_is_a_fixed_point() {
         let f0 = equilibrium(1.0, 0.02, 0.01);
-        for model in [CollisionModel::Bgk, CollisionModel::Mrt(MrtRates::standard(0.6))] {
+        for model in [
+            CollisionModel::Bgk,
+            CollisionModel::Mrt(MrtRates::standard(0.6)),
+        ] {
             let mut a: [[f64; 1]; Q] = std::array::from_fn(|i| [f0[i]]);
             Collider::<f64>::new(model, 0.6, Some(0.1), [0.0; 2]).collide(&mut a);
             for i in 0..Q {

@@ -1,7 +1,7 @@
 //! The `granflow` command line.
 
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
@@ -116,7 +116,7 @@ fn real_main() -> Result<ExitCode> {
     }
 }
 
-fn check(path: &PathBuf) -> Result<ExitCode> {
+fn check(path: &Path) -> Result<ExitCode> {
     let s = Scenario::from_file(path)?;
     let d = s.derive()?;
     let u = &d.units;
@@ -175,7 +175,7 @@ fn check(path: &PathBuf) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn run(path: &PathBuf, out: &PathBuf) -> Result<ExitCode> {
+fn run(path: &Path, out: &Path) -> Result<ExitCode> {
     let s = Scenario::from_file(path)?;
     let d = s.derive()?;
     eprintln!(

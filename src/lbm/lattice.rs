@@ -78,6 +78,13 @@ struct Shared<T>(*mut T);
 unsafe impl<T> Send for Shared<T> {}
 unsafe impl<T> Sync for Shared<T> {}
 
+impl<T> Shared<T> {
+    /// The pointer (a method, so closures capture the `Sync` wrapper, not the raw field).
+    fn get(self) -> *mut T {
+        self.0
+    }
+}
+
 impl<T: Real> Lattice<T> {
     /// A lattice of `nx × ny` cells with the given edges and solid mask (`solid[y·nx + x]`),
     /// filled with fluid at rest at unit density.
@@ -156,23 +163,10 @@ impl<T: Real> Lattice<T> {
 
     /// Set every fluid cell to the equilibrium of `init(x, y) = (ρ, u_x, u_y)` (lattice units).
     pub fn fill(&mut self, init: impl Fn(usize, usize) -> (f64, f64, f64)) {
-        let n = self.stride;
-        self.even = true;
-        for y in 0..self.ny {
-            for x in 0..self.nx {
-                let c = y * self.nx + x;
-                let feq = if self.solid[c] {
-                    [0.0; Q]
-                } else {
-                    let (r, u, v) = init(x, y);
-                    equilibrium(r, u, v)
-                };
-                for i in 0..Q {
-                    // Even step reads A[x][i] as f_i.
-                    self.f[i * n + c] = T::c(feq[i]);
-                }
-            }
-        }
+        self.fill_populations(|x, y| {
+            let (r, u, v) = init(x, y);
+            equilibrium(r, u, v)
+        });
     }
 
     /// Set every fluid cell's populations from `pops(x, y)` (pre-collision, lattice units).
@@ -185,8 +179,9 @@ impl<T: Real> Lattice<T> {
             } else {
                 pops(c % self.nx, c / self.nx)
             };
-            for i in 0..Q {
-                self.f[i * n + c] = T::c(p[i]);
+            // The next step is even: it reads A[x][i] as f_i.
+            for (i, v) in p.iter().enumerate() {
+                self.f[i * n + c] = T::c(*v);
             }
         }
     }
@@ -326,14 +321,13 @@ impl<T: Real> Lattice<T> {
         let specials = &self.specials;
         let wall_corr = &self.wall_corr;
         self.rows.par_iter().enumerate().for_each(|(y, plan)| {
-            let base = base;
             for &(x0, x1) in &plan.runs {
                 // SAFETY: within a step each slot is read and written by exactly one node (see
                 // module docs); bulk nodes of row y touch slots of their own node (even) or of
                 // their 8 in-domain neighbours (odd), which no other node touches.
                 unsafe {
                     bulk_run(
-                        base.0,
+                        base.get(),
                         n,
                         nx,
                         ny,
@@ -348,7 +342,14 @@ impl<T: Real> Lattice<T> {
             for &s in &plan.specials {
                 // SAFETY: as above; special nodes touch only their own link slots.
                 unsafe {
-                    special_node(base.0, n, &specials[s as usize], even, collider, wall_corr)
+                    special_node(
+                        base.get(),
+                        n,
+                        &specials[s as usize],
+                        even,
+                        collider,
+                        wall_corr,
+                    )
                 };
             }
         });

@@ -144,7 +144,7 @@ impl<T: Real> Lbm<T> {
                 return false;
             }
             let (r, u, v) = self.cell(c);
-            !(r > 0.0) || !u.is_finite() || !v.is_finite() || (u * u + v * v).sqrt() / cs > max_mach
+            r.is_nan() || r <= 0.0 || !u.is_finite() || !v.is_finite() || (u * u + v * v).sqrt() / cs > max_mach
         })
         .map(|c| {
             let (r, u, v) = self.cell(c);

@@ -177,6 +177,15 @@ fn bad_input_names_the_field_and_the_reason() {
         },
         &["boundaries.left/right", "periodic"],
     );
+    check_error(
+        |t| {
+            t.replace(
+                "top = { type = \"wall\" }",
+                "top = { type = \"moving_wall\", velocity = [0.0, 1.0e-5] }",
+            )
+        },
+        &["boundaries.top.velocity", "slide"],
+    );
     // Unknown and missing keys are refused by the parser, naming the key.
     check_error(
         |t| t.replace("viscosity = 1.0e-6", "viscosity = 1.0e-6\nviscosty = 2.0"),

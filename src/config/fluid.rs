@@ -377,7 +377,22 @@ impl Scenario {
         check_u("initial.velocity", self.initial.velocity)?;
         for (name, e) in self.edges_named() {
             match e {
-                EdgeSpec::MovingWall { velocity } | EdgeSpec::Velocity { velocity, .. } => {
+                EdgeSpec::MovingWall { velocity } => {
+                    check_u(&format!("boundaries.{name}.velocity"), *velocity)?;
+                    // Half-way bounce-back of a wall moving through itself adds or removes mass.
+                    let normal = if name == "left" || name == "right" {
+                        velocity[0]
+                    } else {
+                        velocity[1]
+                    };
+                    if normal != 0.0 {
+                        return Err(Error::config(
+                            format!("boundaries.{name}.velocity"),
+                            "a moving wall may only slide along itself: the normal component must be 0",
+                        ));
+                    }
+                }
+                EdgeSpec::Velocity { velocity, .. } => {
                     check_u(&format!("boundaries.{name}.velocity"), *velocity)?
                 }
                 EdgeSpec::Pressure { pressure } if !pressure.is_finite() => {

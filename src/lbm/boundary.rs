@@ -140,32 +140,39 @@ pub struct ZouHeNode {
 }
 
 /// Fill the unknown populations (bit `i` of `unknown` set) of a Zou–He node; see module docs.
-pub fn zou_he<T: Real>(f: &mut [T; Q], unknown: u16, node: &ZouHeNode) {
+///
+/// `shift` is F/2, half the body force: with Guo forcing the velocity is (Σ f e + F/2)/ρ, so the
+/// closure imposes the momentum j = ρu − F/2 (zero body force: j = ρu).
+pub fn zou_he<T: Real>(f: &mut [T; Q], unknown: u16, node: &ZouHeNode, shift: [f64; 2]) {
     let [nx, ny] = node.normal;
-    let (tx, ty) = (-ny, nx);
+    let (n, t) = ([nx as f64, ny as f64], [-ny as f64, nx as f64]);
+    let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
     let cn = |i: usize| CX[i] * nx + CY[i] * ny;
-    let ct = |i: usize| (CX[i] * tx + CY[i] * ty) as f64;
+    let ct = |i: usize| CX[i] as f64 * t[0] + CY[i] as f64 * t[1];
     let is_unknown = |i: usize| unknown & (1 << i) != 0;
-    let known: f64 = (0..Q)
+    // Mass and normal momentum of the unknowns coincide (all have e·n = 1):
+    // ρ − Σ_known f = j·n − Σ_known f e·n, i.e. S = Σ_known f (1 − e·n) = ρ − j·n.
+    let s: f64 = (0..Q)
         .filter(|&i| !is_unknown(i))
         .map(|i| f[i].f64() * (1 - cn(i)) as f64)
         .sum();
-    let (rho, u) = match node.value {
-        ZouHe::Velocity(u) => (known / (1.0 - (u[0] * nx as f64 + u[1] * ny as f64)), u),
+    let (rho, j) = match node.value {
+        ZouHe::Velocity(u) => {
+            let rho = (s - dot(shift, n)) / (1.0 - dot(u, n));
+            (rho, [rho * u[0] - shift[0], rho * u[1] - shift[1]])
+        }
         ZouHe::Pressure(rho) => {
-            let un = 1.0 - known / rho;
-            (rho, [un * nx as f64, un * ny as f64])
+            let (jn, jt) = (rho - s, -dot(shift, t));
+            (rho, [jn * n[0] + jt * t[0], jn * n[1] + jt * t[1]])
         }
     };
     let mut g: [f64; Q] = std::array::from_fn(|i| f[i].f64());
     for i in (0..Q).filter(|&i| is_unknown(i)) {
-        let cu = CX[i] as f64 * u[0] + CY[i] as f64 * u[1];
-        g[i] = g[OPP[i]] + 6.0 * W[i] * rho * cu;
+        g[i] = g[OPP[i]] + 6.0 * W[i] * (CX[i] as f64 * j[0] + CY[i] as f64 * j[1]);
     }
     // Residuals of mass and tangential momentum, removed by δ_i = λ + μ t_i.
     let r_m = rho - g.iter().sum::<f64>();
-    let r_t =
-        rho * (u[0] * tx as f64 + u[1] * ty as f64) - (0..Q).map(|i| g[i] * ct(i)).sum::<f64>();
+    let r_t = dot(j, t) - (0..Q).map(|i| g[i] * ct(i)).sum::<f64>();
     let (mut k, mut st, mut stt) = (0.0, 0.0, 0.0);
     for i in (0..Q).filter(|&i| is_unknown(i)) {
         k += 1.0;
@@ -205,6 +212,7 @@ mod tests {
                 normal: [1, 0],
                 value: ZouHe::Velocity([ux, uy]),
             },
+            [0.0; 2],
         );
         let rho = (f[0] + f[2] + f[4] + 2.0 * (f[3] + f[6] + f[7])) / (1.0 - ux);
         assert_relative_eq!(g[1], f[3] + 2.0 / 3.0 * rho * ux, max_relative = 1e-13);
@@ -238,6 +246,7 @@ mod tests {
                 normal: [-1, 0],
                 value: ZouHe::Pressure(1.0),
             },
+            [0.0; 2],
         );
         let (r, _, jy) = moments(&f);
         assert_relative_eq!(r, 1.0, max_relative = 1e-14);
@@ -259,10 +268,27 @@ mod tests {
                 normal: [1, 0],
                 value: ZouHe::Velocity([ux, uy]),
             },
+            [0.0; 2],
         );
         let (r, jx, jy) = moments(&f);
         assert_relative_eq!(jx / r, ux, max_relative = 1e-12);
         assert!((jy / r - uy).abs() < 1e-14);
+    }
+
+    /// With a body force F the closure imposes (Σ f e + F/2)/ρ = u.
+    #[test]
+    fn velocity_edge_with_body_force() {
+        let (u, force) = ([0.03, 0.01], [2e-4, -1e-4]);
+        let mut f = equilibrium(1.0, 0.03, 0.0);
+        let unknown = (1 << 1) | (1 << 5) | (1 << 8);
+        let node = ZouHeNode {
+            normal: [1, 0],
+            value: ZouHe::Velocity(u),
+        };
+        zou_he(&mut f, unknown, &node, [0.5 * force[0], 0.5 * force[1]]);
+        let (r, jx, jy) = moments(&f);
+        assert_relative_eq!((jx + 0.5 * force[0]) / r, u[0], max_relative = 1e-12);
+        assert_relative_eq!((jy + 0.5 * force[1]) / r, u[1], max_relative = 1e-12);
     }
 
     #[test]

@@ -70,6 +70,9 @@ pub struct Lattice<T> {
     special_of: Vec<u32>,
     /// True when the next step is even.
     even: bool,
+    /// Half the body force, F/2 (lattice units), by which the Zou–He closure shifts the
+    /// momentum it imposes: with Guo forcing the velocity is u = (Σ f e + F/2)/ρ.
+    zh_shift: [f64; 2],
 }
 
 /// A raw pointer that may cross threads; see the SAFETY notes where it is dereferenced.
@@ -130,6 +133,7 @@ impl<T: Real> Lattice<T> {
             specials: Vec::new(),
             special_of: vec![u32::MAX; n],
             even: true,
+            zh_shift: [0.0; 2],
         };
         lat.plan();
         lat.fill(|_, _| (1.0, 0.0, 0.0));
@@ -169,6 +173,12 @@ impl<T: Real> Lattice<T> {
         });
     }
 
+    /// Set the body force the Zou–He closure accounts for (normally set by each step from the
+    /// collision operator; call it before observing a lattice that has not stepped yet).
+    pub fn set_body_force(&mut self, force: [f64; 2]) {
+        self.zh_shift = [0.5 * force[0], 0.5 * force[1]];
+    }
+
     /// Set every fluid cell's populations from `pops(x, y)` (pre-collision, lattice units).
     pub fn fill_populations(&mut self, pops: impl Fn(usize, usize) -> [f64; Q]) {
         let n = self.stride;
@@ -196,16 +206,30 @@ impl<T: Real> Lattice<T> {
         if self.edges.bottom == Edge::Periodic {
             ty = ty.rem_euclid(ny);
         }
-        let edge = if ty < 0 {
-            Some(self.edges.bottom.clone())
-        } else if ty >= ny {
-            Some(self.edges.top.clone())
-        } else if tx < 0 {
-            Some(self.edges.left.clone())
+        let ex = if tx < 0 {
+            Some(&self.edges.left)
         } else if tx >= nx {
-            Some(self.edges.right.clone())
+            Some(&self.edges.right)
         } else {
             None
+        };
+        let ey = if ty < 0 {
+            Some(&self.edges.bottom)
+        } else if ty >= ny {
+            Some(&self.edges.top)
+        } else {
+            None
+        };
+        // A diagonal leaving through a corner crosses two edges: a wall wins, so a Zou–He
+        // corner node is treated alike whichever axis its wall is on.
+        let edge = match (ex, ey) {
+            (None, None) => None,
+            (Some(e), None) | (None, Some(e)) => Some(e.clone()),
+            (Some(a), Some(b)) => Some(if matches!(a, Edge::Wall { .. }) {
+                a.clone()
+            } else {
+                b.clone()
+            }),
         };
         match edge {
             None => {
@@ -317,6 +341,8 @@ impl<T: Real> Lattice<T> {
     /// One fused stream–collide step.
     pub fn step(&mut self, collider: &Collider<T>) {
         let (nx, ny, n, even) = (self.nx, self.ny, self.stride, self.even);
+        self.zh_shift = [0.5 * collider.force[0], 0.5 * collider.force[1]];
+        let zh_shift = self.zh_shift;
         let base = Shared(self.f.as_mut_ptr());
         let specials = &self.specials;
         let wall_corr = &self.wall_corr;
@@ -349,6 +375,7 @@ impl<T: Real> Lattice<T> {
                         even,
                         collider,
                         wall_corr,
+                        zh_shift,
                     )
                 };
             }
@@ -358,14 +385,28 @@ impl<T: Real> Lattice<T> {
 
     /// Pre-collision populations of fluid cell `c` at the current time (after streaming and
     /// boundary closure): what the next step will collide.
+    /// A solid cell has no populations: it reports the rest state at unit density.
     pub fn populations(&self, c: usize) -> [T; Q] {
+        if self.solid[c] {
+            return std::array::from_fn(|i| T::c(W[i]));
+        }
         let n = self.stride;
         let f = &self.f;
         let s = self.special_of[c];
         if s != u32::MAX {
             let sp = &self.specials[s as usize];
             // SAFETY: read-only access through a pointer derived from a shared borrow.
-            return unsafe { gather(f.as_ptr() as *mut T, n, sp, self.even, &self.wall_corr).0 };
+            return unsafe {
+                gather(
+                    f.as_ptr() as *mut T,
+                    n,
+                    sp,
+                    self.even,
+                    &self.wall_corr,
+                    self.zh_shift,
+                )
+                .0
+            };
         }
         if self.even {
             std::array::from_fn(|i| f[i * n + c])
@@ -481,6 +522,7 @@ unsafe fn gather<T: Real>(
     sp: &Special,
     even: bool,
     wall_corr: &[[T; Q]],
+    zh_shift: [f64; 2],
 ) -> ([T; Q], u16) {
     let c = sp.cell as usize;
     let mut g = [T::zero(); Q];
@@ -511,7 +553,7 @@ unsafe fn gather<T: Real>(
         }
     }
     if let Some(node) = &sp.zou_he {
-        zou_he(&mut g, unknown, node);
+        zou_he(&mut g, unknown, node, zh_shift);
     }
     (g, unknown)
 }
@@ -527,9 +569,10 @@ unsafe fn special_node<T: Real>(
     even: bool,
     collider: &Collider<T>,
     wall_corr: &[[T; Q]],
+    zh_shift: [f64; 2],
 ) {
     let c = sp.cell as usize;
-    let (g, _) = gather(f, n, sp, even, wall_corr);
+    let (g, _) = gather(f, n, sp, even, wall_corr, zh_shift);
     let mut buf: [[T; 1]; Q] = std::array::from_fn(|i| [g[i]]);
     collider.collide(&mut buf);
     for i in 0..Q {

@@ -224,12 +224,13 @@ impl Obstacles {
                 if !lat.is_solid(b) {
                     continue;
                 }
-                let a = [x as f64 + 0.5, y as f64 + 0.5];
                 let e = [CX[i] as f64, CY[i] as f64];
-                // Shapes may not cross periodic edges (the scenario check refuses it), so the
-                // wrapped solid node's centre identifies the owner.
+                // Shapes lie inside the domain (the scenario check refuses points outside), so
+                // the wrapped solid node's centre identifies the owner.
                 let bc = [(b as i64 % nx) as f64 + 0.5, (b as i64 / nx) as f64 + 0.5];
                 let owner = self.list.iter().position(|o| o.shape.contains(bc));
+                // The fluid node seen from the solid node (unwrapped across a periodic edge).
+                let a = [bc[0] - e[0], bc[1] - e[1]];
                 let Some(owner) = owner else { continue };
                 let ob = &self.list[owner];
                 let q = if ob.interpolated {
@@ -320,6 +321,34 @@ mod tests {
         for s in &shapes {
             assert!(s.contains(s.centre()), "{s:?}");
             assert!(!s.contains([10.0, 10.0]));
+        }
+    }
+
+    /// Regression (review finding): a link from x = nx − 1 across a periodic edge into a shape
+    /// touching x = 0 must get q and the torque arm of the wrapped geometry.
+    #[test]
+    fn links_across_a_periodic_edge() {
+        use crate::lbm::{Edges, Lattice};
+        let mut obs = Obstacles::new(vec![Obstacle {
+            name: "block".into(),
+            shape: Shape::Rectangle {
+                min: [0.0, 2.0],
+                max: [2.5, 5.0],
+            },
+            interpolated: true,
+        }]);
+        let solid = obs.mask(10, 8);
+        let lat = Lattice::<f64>::new(10, 8, Edges::periodic(), solid).unwrap();
+        obs.link(&lat);
+        let across: Vec<&Link> = obs
+            .links
+            .iter()
+            .filter(|l| l.cell as usize % 10 == 9 && l.dir == 1)
+            .collect();
+        assert!(!across.is_empty());
+        for l in across {
+            assert!((l.q - 0.5).abs() < 1e-9, "q = {}", l.q);
+            assert!((l.arm[0] - (-1.25)).abs() < 1e-9, "arm = {:?}", l.arm);
         }
     }
 

@@ -76,12 +76,13 @@ pub struct Lbm<T> {
 impl<T: Real> Lbm<T> {
     /// Assemble a solver; links the obstacles to the lattice.
     pub fn new(
-        lattice: Lattice<T>,
+        mut lattice: Lattice<T>,
         collider: Collider<T>,
         mut obstacles: Obstacles,
         units: Units,
     ) -> Self {
         obstacles.link(&lattice);
+        lattice.set_body_force(collider.force);
         Lbm {
             lattice,
             collider,
@@ -238,6 +239,8 @@ pub struct LbmSnapshot<T> {
     populations: Vec<T>,
     next_even: bool,
     steps: u64,
+    force: Vec<[f64; 2]>,
+    torque: Vec<f64>,
 }
 
 impl<T: Real> Scale for Lbm<T> {
@@ -274,10 +277,14 @@ impl<T: Real> Scale for Lbm<T> {
             populations,
             next_even,
             steps: self.steps,
+            force: self.obstacles.force.clone(),
+            torque: self.obstacles.torque.clone(),
         }
     }
     fn restore(&mut self, s: LbmSnapshot<T>) {
         self.lattice.set_state(s.populations, s.next_even);
         self.steps = s.steps;
+        self.obstacles.force = s.force;
+        self.obstacles.torque = s.torque;
     }
 }

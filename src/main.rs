@@ -46,6 +46,9 @@ enum Command {
         /// Full resolution (slower) instead of the test resolution.
         #[arg(long)]
         full: bool,
+        /// Write each case's figures as `<DIR>/<name>.svg` (DIR is created if needed).
+        #[arg(long, value_name = "DIR")]
+        figures: Option<PathBuf>,
     },
     /// Throughput benchmarks.
     Bench {
@@ -111,7 +114,12 @@ fn real_main() -> Result<ExitCode> {
     match Cli::parse().command {
         Command::Check { scenario } => check(&scenario),
         Command::Run { scenario, out } => run(&scenario, &out),
-        Command::Validate { case, json, full } => validate_cmd(&case, json, full),
+        Command::Validate {
+            case,
+            json,
+            full,
+            figures,
+        } => validate_cmd(&case, json, full, figures.as_deref()),
         Command::Bench { which } => bench(which),
     }
 }
@@ -252,7 +260,7 @@ fn print_check(c: &Check, json: bool) {
     }
 }
 
-fn validate_cmd(case: &str, json: bool, full: bool) -> Result<ExitCode> {
+fn validate_cmd(case: &str, json: bool, full: bool, figures: Option<&Path>) -> Result<ExitCode> {
     if case == "list" {
         for c in validate::CASES {
             println!("{:<16} {}", c.name, c.description);
@@ -265,13 +273,29 @@ fn validate_cmd(case: &str, json: bool, full: bool) -> Result<ExitCode> {
     } else {
         vec![case]
     };
+    if let Some(dir) = figures {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create the figures folder {}", dir.display()))?;
+    }
     let mut failed = 0;
     for name in names {
         match validate::run(name, fidelity) {
-            Ok(checks) => {
-                for c in &checks {
+            Ok(report) => {
+                for c in &report.checks {
                     print_check(c, json);
                     failed += usize::from(!c.pass);
+                }
+                if let Some(dir) = figures {
+                    for plot in &report.plots {
+                        let path = dir.join(format!("{}.svg", plot.name));
+                        match granflow::io::write_svg(plot, &path) {
+                            Ok(()) => eprintln!("figure {}", path.display()),
+                            Err(e) => {
+                                failed += 1;
+                                eprintln!("ERROR figure {}: {e}", path.display());
+                            }
+                        }
+                    }
                 }
             }
             Err(e) => {

@@ -1,12 +1,13 @@
-//! The basic fluid validation cases at [`Fidelity::Test`]: every check must pass.
+//! The basic fluid validation cases at [`Fidelity::Test`]: every check must pass, and every
+//! case returns at least one figure with data.
 
 use granflow::validate::{self, Check, Fidelity};
 
 fn run_case(name: &str) {
     let t = std::time::Instant::now();
-    let checks: Vec<Check> =
-        validate::run(name, Fidelity::Test).unwrap_or_else(|e| panic!("{name}: {e}"));
-    for c in &checks {
+    let report = validate::run(name, Fidelity::Test).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let checks: &[Check] = &report.checks;
+    for c in checks {
         println!(
             "{:<14} {:<80} value {:>12.5e}  ref {:>12.5e}  tol {:>9.2e}  {}",
             c.case,
@@ -34,6 +35,22 @@ fn run_case(name: &str) {
         "{name}: failed checks:\n{}",
         failed.join("\n")
     );
+    assert!(!report.plots.is_empty(), "{name}: no plots");
+    for p in &report.plots {
+        assert!(
+            !p.series.is_empty(),
+            "{name}: plot {} has no series",
+            p.name
+        );
+        for s in &p.series {
+            assert!(
+                !s.points.is_empty(),
+                "{name}: plot {}, series {} is empty",
+                p.name,
+                s.label
+            );
+        }
+    }
 }
 
 #[test]

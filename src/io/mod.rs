@@ -1,5 +1,5 @@
 //! Output files: VTK (`.vti` images, `.vtu` point/line sets), ParaView collections (`.pvd`),
-//! CSV time series and JSON summaries.
+//! CSV time series, JSON summaries and SVG figures.
 //!
 //! Every whole-file writer goes through [`write_atomic`]: the data is written to a hidden
 //! temporary file beside the target, synced, and renamed over it, so a run killed mid-write
@@ -9,11 +9,13 @@
 pub mod atomic;
 pub mod csv;
 pub mod json;
+pub mod plot;
 pub mod pvd;
 pub mod vtk;
 
 pub use atomic::{write_atomic, write_atomic_bytes};
 pub use csv::CsvWriter;
 pub use json::write_json;
+pub use plot::write_svg;
 pub use pvd::{PvdEntry, PvdSeries};
 pub use vtk::{write_vti, write_vtu_points, Field, FieldData, ImageGrid};

@@ -11,7 +11,7 @@
 //! Gates (the issue; REFERENCES.md): max |Δu|, |Δv| ≤ 0.02 U on the centre lines, and the vortex
 //! centre within 0.02 L of Ghia's.
 
-use super::{Check, Fidelity};
+use super::{Check, Fidelity, Plot, Report, Series};
 use crate::config::Scenario;
 use crate::lbm::{Lbm, Macroscopic};
 use crate::Result;
@@ -278,6 +278,38 @@ fn compare(name: &str, field: &Field, ghia: &Ghia) -> Vec<Check> {
     ]
 }
 
+/// u on the vertical and v on the horizontal centre line beside Ghia's points.
+fn plots(name: &str, field: &Field, ghia: &Ghia) -> Vec<Plot> {
+    let (n, re) = (field.n, ghia.re);
+    let s = |k: usize| (k as f64 + 0.5) / n as f64;
+    let u_line = (0..n)
+        .map(|k| (field.at(&field.u, 0.5, s(k)), s(k)))
+        .collect();
+    let v_line = (0..n)
+        .map(|k| (s(k), field.at(&field.v, s(k), 0.5)))
+        .collect();
+    let u = Plot::new(
+        &format!("{name}-u"),
+        &format!("Lid-driven cavity, Re {re}, {n}²: u on x = 0.5"),
+        "u / U",
+        "y / L",
+    )
+    .with(Series::line("LBM", u_line))
+    .with(Series::markers(
+        "Ghia et al. 1982",
+        ghia.u.iter().map(|&(y, u)| (u, y)).collect(),
+    ));
+    let v = Plot::new(
+        &format!("{name}-v"),
+        &format!("Lid-driven cavity, Re {re}, {n}²: v on y = 0.5"),
+        "x / L",
+        "v / U",
+    )
+    .with(Series::line("LBM", v_line))
+    .with(Series::markers("Ghia et al. 1982", ghia.v.to_vec()));
+    vec![u, v]
+}
+
 fn cells(f: Fidelity) -> usize {
     match f {
         Fidelity::Test => 128,
@@ -286,16 +318,22 @@ fn cells(f: Fidelity) -> usize {
 }
 
 /// Re 100 (BGK).
-pub fn run_re100(f: Fidelity) -> Result<Vec<Check>> {
+pub fn run_re100(f: Fidelity) -> Result<Report> {
     let field = solve(include_str!("../../models/lbm/cavity_re100.toml"), cells(f))?;
-    Ok(compare("cavity-re100", &field, &GHIA_100))
+    Ok(Report {
+        checks: compare("cavity-re100", &field, &GHIA_100),
+        plots: plots("cavity-re100", &field, &GHIA_100),
+    })
 }
 
 /// Re 1000 (MRT).
-pub fn run_re1000(f: Fidelity) -> Result<Vec<Check>> {
+pub fn run_re1000(f: Fidelity) -> Result<Report> {
     let field = solve(
         include_str!("../../models/lbm/cavity_re1000.toml"),
         cells(f),
     )?;
-    Ok(compare("cavity-re1000", &field, &GHIA_1000))
+    Ok(Report {
+        checks: compare("cavity-re1000", &field, &GHIA_1000),
+        plots: plots("cavity-re1000", &field, &GHIA_1000),
+    })
 }

@@ -18,7 +18,7 @@
 //! predicted −5.55e-13), BGK carried a similar bias. The collision now sets the rest population
 //! from the mass, f₀* = ρ − Σ_{i≥1} f_i*, and the drift is at round-off (≈ 4e-16).
 
-use super::{Check, Fidelity};
+use super::{Check, Fidelity, Plot, Report, Series};
 use crate::config::{CollisionKind, Scenario};
 use crate::Result;
 
@@ -42,6 +42,8 @@ struct Budget {
     momentum_residual: [f64; 2],
     /// Σ_cells ρ|u| at the end: the magnitude the momentum sum is made of.
     momentum_scale: f64,
+    /// (step, |M(t) − M(0)|/M(0)) at the samples.
+    mass_history: Vec<(f64, f64)>,
 }
 
 /// Refine to `cells` per side at constant lattice Mach (Δt ∝ Δx) and set 10⁴ steps.
@@ -98,10 +100,13 @@ fn budget(sc: &Scenario, stir: bool) -> Result<Budget> {
     let m0 = lbm.lattice.total_mass();
     let p0 = momentum(&lbm);
     let mut drift_max: f64 = 0.0;
+    let mut mass_history = vec![(0.0, 0.0)];
     for s in 1..=d.steps {
         lbm.step();
         if s % SAMPLE_EVERY == 0 {
-            drift_max = drift_max.max(((lbm.lattice.total_mass() - m0) / m0).abs());
+            let drift = ((lbm.lattice.total_mass() - m0) / m0).abs();
+            drift_max = drift_max.max(drift);
+            mass_history.push((s as f64, drift));
         }
     }
     let m1 = lbm.lattice.total_mass();
@@ -117,20 +122,31 @@ fn budget(sc: &Scenario, stir: bool) -> Result<Budget> {
             p1[1] - p0[1] - cells * t * fy,
         ],
         momentum_scale: magnitude(&lbm),
+        mass_history,
     })
 }
 
 /// Run the case.
-pub fn run(f: Fidelity) -> Result<Vec<Check>> {
+pub fn run(f: Fidelity) -> Result<Report> {
     let cells = match f {
         Fidelity::Test => 64,
         Fidelity::Full => 128,
     };
     let mut checks = Vec::new();
+    let mut plot = Plot::new(
+        "conservation-mass",
+        &format!("Mass drift over 10⁴ steps, {cells}² cells, f64"),
+        "step",
+        "|M(t) − M(0)| / M(0)",
+    );
     for (name, collision) in [("BGK", CollisionKind::Bgk), ("MRT", CollisionKind::Mrt)] {
         let mut closed = Scenario::from_toml(CLOSED)?;
         resolve(&mut closed, cells, collision);
         let b = budget(&closed, false)?;
+        plot = plot.with(Series::line(
+            &format!("{name}, closed lid box"),
+            b.mass_history.clone(),
+        ));
         let q = format!("{name}, closed lid box {cells}²: max |ΔM|/M over 10⁴ steps");
         checks.push(Check::at_most(CASE, &q, b.mass_drift_max, TOL));
         let q = format!("{name}, closed lid box: signed ΔM/M at the end");
@@ -139,6 +155,10 @@ pub fn run(f: Fidelity) -> Result<Vec<Check>> {
         let mut forced = Scenario::from_toml(PERIODIC)?;
         resolve(&mut forced, cells, collision);
         let b = budget(&forced, true)?;
+        plot = plot.with(Series::line(
+            &format!("{name}, periodic box with force"),
+            b.mass_history.clone(),
+        ));
         let q = format!("{name}, periodic box {cells}² with force: max |ΔM|/M over 10⁴ steps");
         checks.push(Check::at_most(CASE, &q, b.mass_drift_max, TOL));
         let q = format!("{name}, periodic box with force: signed ΔM/M at the end");
@@ -156,5 +176,8 @@ pub fn run(f: Fidelity) -> Result<Vec<Check>> {
         let q = format!("{name}, periodic box without force: max |ΔM|/M");
         checks.push(Check::at_most(CASE, &q, b.mass_drift_max, TOL));
     }
-    Ok(checks)
+    Ok(Report {
+        checks,
+        plots: vec![plot],
+    })
 }

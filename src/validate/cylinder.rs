@@ -6,7 +6,7 @@
 //! an even and an odd AA step, and are converted to SI per unit depth with
 //! [`Units::force_to_si`](crate::units::Units::force_to_si).
 
-use super::{Check, Fidelity};
+use super::{Check, Fidelity, Plot, Report, Series, MAX_PLOT_POINTS};
 use crate::analysis::spectrum::dominant_frequency;
 use crate::config::{Derived, EdgeSpec, ObstacleSpec, Scenario};
 use crate::lbm::Lbm;
@@ -191,7 +191,7 @@ impl Sample2d1 {
 
 /// Schäfer–Turek 2D-1: c_D within 1 % of 5.58 and Δp within 2 % at D ≥ 40 cells (Test: 40,
 /// Full: 80); L_a and c_L reported.
-pub fn run_2d1(fidelity: Fidelity) -> Result<Vec<Check>> {
+pub fn run_2d1(fidelity: Fidelity) -> Result<Report> {
     let mut scn = Scenario::from_toml(TOML_2D1)?;
     if fidelity == Fidelity::Full {
         refine(&mut scn, 2.0);
@@ -200,10 +200,11 @@ pub fn run_2d1(fidelity: Fidelity) -> Result<Vec<Check>> {
     let d = scn.derive()?;
     let mut lbm = scn.build_typed::<f64>(&d)?;
     start_as_channel_flow(&mut lbm, &d, ch.u_max);
-    let (m, drift) = run_to_steady(&mut lbm, &d, &ch)?;
+    let (m, drift, history) = run_to_steady(&mut lbm, &d, &ch)?;
     let case = "cylinder-2d1";
     let cells = ch.d / d.units.dx;
-    Ok(vec![
+    let plots = plots_2d1(&lbm, &d, &ch, history, cells);
+    let checks = vec![
         // Gate of the issue: 1 % at D ≥ 40 cells (the published interval is ±0.2 %).
         Check::rel(case, "drag coefficient c_D", m.cd, st::CD, 0.01),
         // Gate of the issue: 2 % at D ≥ 40 cells (published interval ±0.2 %).
@@ -221,12 +222,69 @@ pub fn run_2d1(fidelity: Fidelity) -> Result<Vec<Check>> {
             drift,
             STEADY_TOL,
         ),
-    ])
+    ];
+    Ok(Report { checks, plots })
+}
+
+/// c_D against time beside the reference, and u_x on the centre line behind the cylinder with
+/// the reference end of the recirculation zone.
+fn plots_2d1(
+    lbm: &Lbm<f64>,
+    d: &Derived,
+    ch: &Channel,
+    history: Vec<(f64, f64)>,
+    cells: f64,
+) -> Vec<Plot> {
+    let t_end = history.last().map_or(0.0, |p| p.0);
+    let means: Vec<(f64, f64)> = history
+        .chunks(WINDOW_SAMPLES as usize)
+        .map(|w| {
+            let n = w.len() as f64;
+            w.iter()
+                .fold((0.0, 0.0), |(t, c), p| (t + p.0 / n, c + p.1 / n))
+        })
+        .collect();
+    let drag = Plot::new(
+        "cylinder-2d1-drag",
+        &format!("Schäfer–Turek 2D-1, D = {cells:.0} cells: drag coefficient"),
+        "t (s)",
+        "c_D",
+    )
+    // The start's sound waves swing c_D far beyond this; the range shows the approach.
+    .y_range(0.85 * st::CD, 1.15 * st::CD)
+    .with(Series::line("LBM, samples", history).decimated(MAX_PLOT_POINTS))
+    .with(Series::line(
+        "Schäfer & Turek 1996 (5.5795)",
+        vec![(0.0, st::CD), (t_end, st::CD)],
+    ))
+    .with(Series::markers("LBM, mean over one acoustic period", means));
+    let rear = ch.center[0] + 0.5 * ch.d;
+    let wake: Vec<(f64, f64)> = axial_profile(lbm, ch.center[1])
+        .into_iter()
+        .flatten()
+        .filter(|p| p.0 > rear)
+        .map(|p| (p.0 - rear, d.units.velocity_to_si(p.2)))
+        .collect();
+    let wake_plot = Plot::new(
+        "cylinder-2d1-wake",
+        "Schäfer–Turek 2D-1: u_x on y = 0.2 m behind the cylinder",
+        "x − x_rear (m)",
+        "u_x (m/s)",
+    )
+    .with(Series::line("LBM", wake).decimated(MAX_PLOT_POINTS))
+    .with(Series::markers(
+        "recirculation end L_a = 0.0847 m (Schäfer & Turek)",
+        vec![(st::LA, 0.0)],
+    ));
+    vec![drag, wake_plot]
 }
 
 /// Relative change of the window-mean c_D between two windows below which the 2D-1 flow
 /// counts as steady: 20× below the 1 % gate.
 const STEADY_TOL: f64 = 5e-4;
+
+/// (t in s, c_D) of every sample of a 2D-1 run.
+type History = Vec<(f64, f64)>;
 
 /// Samples per averaging window.
 const WINDOW_SAMPLES: u64 = 32;
@@ -252,16 +310,23 @@ fn start_as_channel_flow(lbm: &mut Lbm<f64>, d: &Derived, u_max_si: f64) {
 /// the reflecting velocity inlet and the pressure outlet), averaging [`WINDOW_SAMPLES`] evenly
 /// spaced samples, which cancels the sound waves the start leaves behind; stop when the
 /// window-mean c_D changes by less than [`STEADY_TOL`] or at `time.end`. Returns the last
-/// window's means and the relative change.
-fn run_to_steady(lbm: &mut Lbm<f64>, d: &Derived, ch: &Channel) -> Result<(Sample2d1, f64)> {
+/// window's means, the relative change and the history (t in s, c_D) of every sample.
+fn run_to_steady(
+    lbm: &mut Lbm<f64>,
+    d: &Derived,
+    ch: &Channel,
+) -> Result<(Sample2d1, f64, History)> {
     let period = 4.0 * d.cells[0] as f64 / crate::units::CS2.sqrt();
     let every = ((period / WINDOW_SAMPLES as f64).round() as u64).max(2);
     let (mut steps, mut last, mut drift) = (0, Sample2d1::default(), f64::INFINITY);
+    let mut history = Vec::new();
     while steps < d.steps {
         let mut mean = Sample2d1::default();
-        for _ in 0..WINDOW_SAMPLES {
+        for k in 1..=WINDOW_SAMPLES {
             let f = advance(lbm, every);
-            mean = mean.add(sample_2d1(lbm, d, ch, f)?, 1.0 / WINDOW_SAMPLES as f64);
+            let sample = sample_2d1(lbm, d, ch, f)?;
+            history.push(((steps + k * every) as f64 * d.units.dt, sample.cd));
+            mean = mean.add(sample, 1.0 / WINDOW_SAMPLES as f64);
         }
         steps += every * WINDOW_SAMPLES;
         stable(lbm)?;
@@ -271,7 +336,7 @@ fn run_to_steady(lbm: &mut Lbm<f64>, d: &Derived, ch: &Channel) -> Result<(Sampl
             break;
         }
     }
-    Ok((last, drift))
+    Ok((last, drift, history))
 }
 
 /// c_D, c_L from the force `f` (lattice), Δp and L_a from the current fields.
@@ -331,15 +396,17 @@ struct ArrayDrag {
 }
 
 /// Sangani–Acrivos periodic square array: F/(μU) within 3 % for Φ = 0.05, 0.1, 0.2, 0.4.
-pub fn run_array(fidelity: Fidelity) -> Result<Vec<Check>> {
+pub fn run_array(fidelity: Fidelity) -> Result<Report> {
     let mut base = Scenario::from_toml(TOML_ARRAY)?;
     if fidelity == Fidelity::Full {
         refine(&mut base, 2.0);
     }
     let case = "cylinder-array";
     let mut checks = Vec::new();
+    let (mut interpolated, mut halfway) = (Vec::new(), Vec::new());
     for (phi, reference) in SANGANI_ACRIVOS {
         let m = array_drag(&base, phi, true)?;
+        interpolated.push((phi, m.drag));
         // Gate of the issue: 3 % (REFERENCES.md: a stair-stepped cylinder lands within 2–4 %;
         // the interpolated wall sits on the true circle and should do better).
         checks.push(Check::rel(
@@ -365,6 +432,7 @@ pub fn run_array(fidelity: Fidelity) -> Result<Vec<Check>> {
             0.01,
         ));
         let stairs = array_drag(&base, phi, false)?;
+        halfway.push((phi, stairs.drag));
         checks.push(Check::report(
             case,
             &format!("F/(μU) at Φ = {phi}, half-way bounce-back"),
@@ -372,7 +440,23 @@ pub fn run_array(fidelity: Fidelity) -> Result<Vec<Check>> {
             reference,
         ));
     }
-    Ok(checks)
+    let plot = Plot::new(
+        "cylinder-array-drag",
+        "Periodic square array of cylinders: Stokes drag",
+        "solid fraction Φ",
+        "F / (μU)",
+    )
+    .log(false, true)
+    .with(Series::markers(
+        "Sangani & Acrivos 1982",
+        SANGANI_ACRIVOS.to_vec(),
+    ))
+    .with(Series::markers("LBM, interpolated wall", interpolated))
+    .with(Series::markers("LBM, half-way bounce-back", halfway));
+    Ok(Report {
+        checks,
+        plots: vec![plot],
+    })
 }
 
 /// Run one array cell of nominal solid fraction `phi` to steady state, with interpolated or
@@ -499,7 +583,7 @@ fn start_perturbed(lbm: &mut Lbm<f64>, d: &Derived, ch: &Channel) {
 
 /// Seed section 5.3: no sustained shedding at Re 55, shedding at Re 112; St reported beside
 /// Table 5.2.
-pub fn run_shedding(fidelity: Fidelity) -> Result<Vec<Check>> {
+pub fn run_shedding(fidelity: Fidelity) -> Result<Report> {
     let mut lo = Scenario::from_toml(TOML_RE55)?;
     let mut hi = Scenario::from_toml(TOML_RE112)?;
     if fidelity == Fidelity::Full {
@@ -512,7 +596,20 @@ pub fn run_shedding(fidelity: Fidelity) -> Result<Vec<Check>> {
     let (a_calm, a_shed) = (calm.amplitude(0.75, 1.0), shed.amplitude(0.75, 1.0));
     let st =
         |s: &LiftSeries, ch: &Channel, u: f64| s.frequency().map_or(f64::NAN, |f| f * ch.d / u);
-    Ok(vec![
+    let history = |s: &LiftSeries| -> Vec<(f64, f64)> {
+        (s.cl.iter().enumerate())
+            .map(|(k, &c)| ((k + 1) as f64 * s.dt, c))
+            .collect()
+    };
+    let plot = Plot::new(
+        "shedding-lift",
+        "Cylinder in a channel: lift coefficient",
+        "t (s)",
+        "c_L",
+    )
+    .with(Series::line("Re 112", history(&shed)).decimated(MAX_PLOT_POINTS))
+    .with(Series::line("Re 55", history(&calm)).decimated(MAX_PLOT_POINTS));
+    let checks = vec![
         // Shedding at Re 112 (seed Fig. 5.12c): a clear oscillation, c_L amplitude ≥ 0.1 over the
         // last quarter (confined cylinders near Re 100 shed with c_L amplitudes of 0.3–1) ...
         Check::at_least(case, "c_L amplitude at Re 112, last quarter", a_shed, 0.1),
@@ -558,7 +655,11 @@ pub fn run_shedding(fidelity: Fidelity) -> Result<Vec<Check>> {
             st(&shed, &ch_hi, ch_hi.u_mean),
             SEED_ST_112,
         ),
-    ])
+    ];
+    Ok(Report {
+        checks,
+        plots: vec![plot],
+    })
 }
 
 #[cfg(test)]

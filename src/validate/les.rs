@@ -13,7 +13,7 @@
 //! error is the lattice's: the O(Δx²) bounce-back slip (≈ (3 − 16Λ)/(3H²) of u_max for
 //! BGK, Λ = (τ* − ½)², 7e-4 at H = 32) plus the O(Δx²) bulk error of the non-polynomial profile.
 
-use super::{Check, Fidelity};
+use super::{Check, Fidelity, Plot, Report, Series};
 use crate::config::Scenario;
 use crate::Result;
 
@@ -108,7 +108,7 @@ fn solve(base: &Scenario, cells: usize) -> Result<Outcome> {
 }
 
 /// Run the case.
-pub fn run(f: Fidelity) -> Result<Vec<Check>> {
+pub fn run(f: Fidelity) -> Result<Report> {
     let base = Scenario::from_toml(SCENARIO)?;
     let cells: &[usize] = match f {
         Fidelity::Test => &[32, 64],
@@ -116,6 +116,7 @@ pub fn run(f: Fidelity) -> Result<Vec<Check>> {
     };
     let mut checks = Vec::new();
     let mut errors = Vec::new();
+    let mut plots = Vec::new();
     for &n in cells {
         let o = solve(&base, n)?;
         let err = o.max_rel_diff(&o.model);
@@ -145,6 +146,7 @@ pub fn run(f: Fidelity) -> Result<Vec<Check>> {
             // with the other common convention S̄ = √(2 S_ij S_ij) (ν_t larger by √2), the
             // analytic profiles lie far from the LBM one. Gate: at least 10× the tolerance.
             let laminar = MixingChannel { a: 0.0, ..o.model };
+            plots.push(profile_plot(&o, &laminar, n));
             let other = MixingChannel {
                 a: o.model.a * 2f64.sqrt(),
                 ..o.model
@@ -178,7 +180,39 @@ pub fn run(f: Fidelity) -> Result<Vec<Check>> {
         let q = format!("error ratio H = {} → {}", cells[k - 1], cells[k]);
         checks.push(Check::at_least(CASE, &q, errors[k - 1] / errors[k], 3.0));
     }
-    Ok(checks)
+    Ok(Report { checks, plots })
+}
+
+/// LBM profile (markers) beside the analytic LES profile and the laminar parabola (lines),
+/// all divided by the LES centre-line velocity.
+fn profile_plot(o: &Outcome, laminar: &MixingChannel, n: usize) -> Plot {
+    let h = o.model.h;
+    let scale = o.model.u(0.5 * h);
+    let curve = |m: &MixingChannel| {
+        (0..=100)
+            .map(|k| {
+                let y = h * k as f64 / 100.0;
+                (y / h, m.u(y) / scale)
+            })
+            .collect()
+    };
+    let lbm =
+        o.u.iter()
+            .enumerate()
+            .map(|(y, u)| ((y as f64 + 0.5) / h, u / scale))
+            .collect();
+    Plot::new(
+        "les-channel-profile",
+        &format!("Smagorinsky channel, H = {n} cells"),
+        "y / H",
+        "u / u_max(LES)",
+    )
+    .with(Series::line("laminar parabola (ν_t = 0)", curve(laminar)))
+    .with(Series::line(
+        "analytic LES (mixing length)",
+        curve(&o.model),
+    ))
+    .with(Series::markers("LBM + Smagorinsky", lbm))
 }
 
 /// Tolerance on max |u − u_LES|/u_max at H = 32: twice the BGK bounce-back slip estimate

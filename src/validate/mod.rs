@@ -1,8 +1,9 @@
 //! Validation cases: each runs a scenario from `models/` against an analytic solution, a
 //! published table or a conservation law, and reports one [`Check`] per quantity.
 //!
-//! `granflow validate <case|all> [--json]` prints them; the tests under `tests/` run the same
-//! cases at [`Fidelity::Test`] (the smallest resolution that still proves the claim).
+//! `granflow validate <case|all> [--json] [--figures DIR]` prints them (and writes each case's
+//! [`Plot`]s as SVG); the tests under `tests/` run the same cases at [`Fidelity::Test`] (the
+//! smallest resolution that still proves the claim).
 
 use serde::Serialize;
 
@@ -94,6 +95,131 @@ impl Check {
     }
 }
 
+/// What a case returns: its checks and the data of its figures.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Report {
+    /// One per checked quantity.
+    pub checks: Vec<Check>,
+    /// Figures made from data the case computed anyway (no extra simulation).
+    pub plots: Vec<Plot>,
+}
+
+/// How a [`Series`] is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Style {
+    /// Points joined by a line (analytic solutions, time histories).
+    Line,
+    /// One marker per point (measurements, reference tables).
+    Markers,
+}
+
+/// One curve or point set of a [`Plot`].
+#[derive(Clone, Debug, Serialize)]
+pub struct Series {
+    /// Legend entry.
+    pub label: String,
+    /// (x, y) data.
+    pub points: Vec<(f64, f64)>,
+    /// Line or markers.
+    pub style: Style,
+}
+
+impl Series {
+    /// A line through `points`.
+    pub fn line(label: &str, points: Vec<(f64, f64)>) -> Self {
+        Series {
+            label: label.into(),
+            points,
+            style: Style::Line,
+        }
+    }
+
+    /// Markers at `points`.
+    pub fn markers(label: &str, points: Vec<(f64, f64)>) -> Self {
+        Series {
+            label: label.into(),
+            points,
+            style: Style::Markers,
+        }
+    }
+
+    /// Keep at most `max` points (≥ 2) by taking every k-th one, always keeping the last, so
+    /// long time series stay small in a figure.
+    pub fn decimated(mut self, max: usize) -> Self {
+        let n = self.points.len();
+        let max = max.max(2);
+        if n > max {
+            let stride = n.div_ceil(max - 1);
+            let last = self.points[n - 1];
+            let mut kept: Vec<_> = self.points.iter().copied().step_by(stride).collect();
+            if kept.last() != Some(&last) {
+                kept.push(last);
+            }
+            self.points = kept;
+        }
+        self
+    }
+}
+
+/// The data of one figure; `granflow validate --figures DIR` writes it to `DIR/<name>.svg`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Plot {
+    /// File stem, e.g. `poiseuille-profile`.
+    pub name: String,
+    /// Caption drawn above the axes.
+    pub title: String,
+    /// Label of the horizontal axis.
+    pub x_label: String,
+    /// Label of the vertical axis.
+    pub y_label: String,
+    /// Logarithmic horizontal axis.
+    pub log_x: bool,
+    /// Logarithmic vertical axis.
+    pub log_y: bool,
+    /// Fixed vertical range (points outside are drawn at its edge); `None`: fit the data.
+    pub y_range: Option<(f64, f64)>,
+    /// The curves, drawn in order.
+    pub series: Vec<Series>,
+}
+
+impl Plot {
+    /// An empty plot with linear axes.
+    pub fn new(name: &str, title: &str, x_label: &str, y_label: &str) -> Self {
+        Plot {
+            name: name.into(),
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            log_x: false,
+            log_y: false,
+            y_range: None,
+            series: Vec::new(),
+        }
+    }
+
+    /// Fix the vertical range to [lo, hi] instead of fitting the data.
+    pub fn y_range(mut self, lo: f64, hi: f64) -> Self {
+        self.y_range = Some((lo, hi));
+        self
+    }
+
+    /// Logarithmic axes (x, y).
+    pub fn log(mut self, x: bool, y: bool) -> Self {
+        self.log_x = x;
+        self.log_y = y;
+        self
+    }
+
+    /// Add a series.
+    pub fn with(mut self, series: Series) -> Self {
+        self.series.push(series);
+        self
+    }
+}
+
+/// Largest number of points a time series keeps in a figure.
+pub const MAX_PLOT_POINTS: usize = 500;
+
 /// How hard to try.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Fidelity {
@@ -110,7 +236,7 @@ pub struct Case {
     /// One line.
     pub description: &'static str,
     /// Runs it.
-    pub run: fn(Fidelity) -> Result<Vec<Check>>,
+    pub run: fn(Fidelity) -> Result<Report>,
 }
 
 /// All cases, in the order `validate all` runs them.
@@ -163,7 +289,7 @@ pub const CASES: &[Case] = &[
 ];
 
 /// Run a case by name.
-pub fn run(name: &str, fidelity: Fidelity) -> Result<Vec<Check>> {
+pub fn run(name: &str, fidelity: Fidelity) -> Result<Report> {
     let case = CASES.iter().find(|c| c.name == name).ok_or_else(|| {
         let names: Vec<_> = CASES.iter().map(|c| c.name).collect();
         crate::Error::Other(format!(

@@ -16,7 +16,7 @@
 //!   δ = g(16Λ − 3)/(24ν), δ/u_max = (16Λ − 3)/(3H²) in lattice units; MRT with
 //!   Λ = 3/16 has none, so the two profiles differ by exactly δ.
 
-use super::{Check, Fidelity};
+use super::{Check, Fidelity, Plot, Report, Series};
 use crate::config::{CollisionKind, MrtSpec, Scenario};
 use crate::units::CS2;
 use crate::Result;
@@ -128,7 +128,7 @@ pub(super) fn fitted_order(cells: &[usize], errors: &[f64]) -> f64 {
 }
 
 /// Run the case.
-pub fn run(f: Fidelity) -> Result<Vec<Check>> {
+pub fn run(f: Fidelity) -> Result<Report> {
     let base = Scenario::from_toml(SCENARIO)?;
     let magic_tau = base.time.tau.unwrap_or(0.5 + 3f64.sqrt() / 4.0);
     let cells: &[usize] = match f {
@@ -158,8 +158,12 @@ pub fn run(f: Fidelity) -> Result<Vec<Check>> {
     // τ = 0.8: BGK converges at second order (issue: 2.0 ± 0.2 over three resolutions).
     let mut l2 = Vec::new();
     let mut bgk_mid = None;
+    let mut plots = Vec::new();
     for &n in cells {
         let p = solve(&base, n, TAU_OFF_MAGIC, Collision::Bgk)?;
+        if n == cells[0] {
+            plots.push(profile_plot(&p, n));
+        }
         checks.push(Check::report(
             CASE,
             &format!("BGK τ = 0.8, H = {n}: L2 relative error"),
@@ -213,5 +217,53 @@ pub fn run(f: Fidelity) -> Result<Vec<Check>> {
         let q = format!("τ = 0.8, H = {n}: max |u_BGK − u_MRT|/u_max vs (3 − 16Λ)/(3H²)");
         checks.push(Check::rel(CASE, &q, diff, predicted, 0.01));
     }
-    Ok(checks)
+    plots.push(convergence_plot(cells, &l2));
+    Ok(Report { checks, plots })
+}
+
+/// u(y)/u_max of a BGK τ = 0.8 run (markers) beside the parabola (line).
+fn profile_plot(p: &Profile, n: usize) -> Plot {
+    let h = p.u.len() as f64;
+    let lbm =
+        p.u.iter()
+            .enumerate()
+            .map(|(y, u)| ((y as f64 + 0.5) / h, u / p.u_max))
+            .collect();
+    let exact = (0..=100)
+        .map(|k| {
+            let eta = k as f64 / 100.0;
+            (eta, 4.0 * eta * (1.0 - eta))
+        })
+        .collect();
+    Plot::new(
+        "poiseuille-profile",
+        &format!("Poiseuille, BGK τ = 0.8, H = {n} cells"),
+        "y / H",
+        "u / u_max",
+    )
+    .with(Series::line("analytic 4(y/H)(1 − y/H)", exact))
+    .with(Series::markers("LBM", lbm))
+}
+
+/// L2 error against H, log-log, with a slope −2 guide through the coarsest point.
+fn convergence_plot(cells: &[usize], l2: &[f64]) -> Plot {
+    let pts: Vec<(f64, f64)> = cells
+        .iter()
+        .map(|&n| n as f64)
+        .zip(l2.iter().copied())
+        .collect();
+    let (h0, e0) = pts[0];
+    let guide = pts
+        .iter()
+        .map(|&(h, _)| (h, e0 * (h0 / h).powi(2)))
+        .collect();
+    Plot::new(
+        "poiseuille-convergence",
+        "Poiseuille, BGK τ = 0.8: L2 error vs resolution",
+        "H (cells)",
+        "‖u − u_exact‖₂ / ‖u_exact‖₂",
+    )
+    .log(true, true)
+    .with(Series::line("slope −2", guide))
+    .with(Series::markers("LBM", pts))
 }

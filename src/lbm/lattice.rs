@@ -365,13 +365,14 @@ impl<T: Real> Lattice<T> {
                     )
                 };
             }
-            for &s in &plan.specials {
+            for group in plan.specials.chunks(LANES) {
                 // SAFETY: as above; special nodes touch only their own link slots.
                 unsafe {
-                    special_node(
+                    special_nodes(
                         base.get(),
                         n,
-                        &specials[s as usize],
+                        specials,
+                        group,
                         even,
                         collider,
                         wall_corr,
@@ -558,32 +559,48 @@ unsafe fn gather<T: Real>(
     (g, unknown)
 }
 
-/// Stream–collide one special node.
+/// Stream–collide a group of at most [`LANES`] special nodes of one row.
 ///
 /// # Safety
-/// As [`bulk_run`].
-unsafe fn special_node<T: Real>(
+/// As [`bulk_run`]; `group` indexes `specials`.
+#[allow(clippy::too_many_arguments)]
+unsafe fn special_nodes<T: Real>(
     f: *mut T,
     n: usize,
-    sp: &Special,
+    specials: &[Special],
+    group: &[u32],
     even: bool,
     collider: &Collider<T>,
     wall_corr: &[[T; Q]],
     zh_shift: [f64; 2],
 ) {
-    let c = sp.cell as usize;
-    let (g, _) = gather(f, n, sp, even, wall_corr, zh_shift);
-    let mut buf: [[T; 1]; Q] = std::array::from_fn(|i| [g[i]]);
+    // Gather link by link, collide all of the group's nodes as lanes of one vector, scatter.
+    let mut buf = [[T::zero(); LANES]; Q];
+    for (l, &s) in group.iter().enumerate() {
+        let (g, _) = gather(f, n, &specials[s as usize], even, wall_corr, zh_shift);
+        for i in 0..Q {
+            buf[i][l] = g[i];
+        }
+    }
+    for l in group.len()..LANES {
+        for row in buf.iter_mut() {
+            row[l] = row[0];
+        }
+    }
     collider.collide(&mut buf);
-    for i in 0..Q {
-        let v = buf[i][0];
-        if even {
-            *f.add(OPP[i] * n + c) = v;
-        } else {
-            match sp.nb[i] {
-                Neighbour::Fluid(k) => *f.add(i * n + k as usize) = v,
-                Neighbour::Bounce(w) => *f.add(OPP[i] * n + c) = v - wall_corr[w as usize][i],
-                Neighbour::Open => {}
+    for (l, &s) in group.iter().enumerate() {
+        let sp = &specials[s as usize];
+        let c = sp.cell as usize;
+        for i in 0..Q {
+            let v = buf[i][l];
+            if even {
+                *f.add(OPP[i] * n + c) = v;
+            } else {
+                match sp.nb[i] {
+                    Neighbour::Fluid(k) => *f.add(i * n + k as usize) = v,
+                    Neighbour::Bounce(w) => *f.add(OPP[i] * n + c) = v - wall_corr[w as usize][i],
+                    Neighbour::Open => {}
+                }
             }
         }
     }

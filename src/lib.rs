@@ -5,6 +5,7 @@
 //!
 //! | scale | module | method |
 //! |---|---|---|
+//! | grain | [`dem`] | discrete elements: disks, spring-dashpot contacts, friction, rolling resistance |
 //! | fluid | [`lbm`] | D2Q9 lattice Boltzmann, BGK / MRT, Smagorinsky LES |
 //!
 //! DEM grains and the GIMPM continuum are planned (see the issues); the fluid solver, the
@@ -17,6 +18,7 @@
 pub mod analysis;
 pub mod bench;
 pub mod config;
+pub mod dem;
 pub mod error;
 pub mod io;
 pub mod lbm;

@@ -104,7 +104,10 @@ impl ContactParams {
             return err("k_n", format!("must be > 0, got {}", self.k_n));
         }
         if !(self.restitution > 0.0 && self.restitution <= 1.0) {
-            return err("restitution", format!("must be in (0, 1], got {}", self.restitution));
+            return err(
+                "restitution",
+                format!("must be in (0, 1], got {}", self.restitution),
+            );
         }
         Ok(())
     }
@@ -262,7 +265,8 @@ impl Law {
             hist[1] = th_new;
             out.m_r = m;
             out.e_rolling = 0.5 * self.k_r * th_new * th_new;
-            out.d_rolling = 0.5 * self.k_r * (th * th - th_new * th_new) + c_r * w_rel1 * w_rel1 * dt;
+            out.d_rolling =
+                0.5 * self.k_r * (th * th - th_new * th_new) + c_r * w_rel1 * w_rel1 * dt;
         }
         out
     }
@@ -275,17 +279,26 @@ mod tests {
     #[test]
     fn damping_ratio_inverts_restitution() {
         for e in [0.1, 0.3, 0.5, 0.75, 0.95, 1.0] {
-            assert!((restitution_of(damping_ratio(e)) - e).abs() < 1e-14, "e = {e}");
+            assert!(
+                (restitution_of(damping_ratio(e)) - e).abs() < 1e-14,
+                "e = {e}"
+            );
         }
     }
 
     #[test]
     fn coulomb_cap_resets_spring() {
-        let p = ContactParams { k_t: 100.0, friction: 0.5, ..ContactParams::elastic(1000.0) };
+        let p = ContactParams {
+            k_t: 100.0,
+            friction: 0.5,
+            ..ContactParams::elastic(1000.0)
+        };
         let law = Law::from(&p);
         let mut h = [0.0; 2];
         // δ = 0.01 → f_n = 10, cap 5; a tangential slip of 1 would ask for 100.
-        let o = law.resolve(0.01, 0.0, [1.0; 2], [0.0; 2], 1.0, 1.0, &mut h, 1.0, [1.0; 2]);
+        let o = law.resolve(
+            0.01, 0.0, [1.0; 2], [0.0; 2], 1.0, 1.0, &mut h, 1.0, [1.0; 2],
+        );
         assert!((o.f_t + 5.0).abs() < 1e-12);
         assert!((h[0] - 0.05).abs() < 1e-12);
         assert!((o.d_friction - 0.5 * 100.0 * (1.0 - 0.05 * 0.05)).abs() < 1e-9);

@@ -49,7 +49,10 @@ impl Energy {
 
     /// All dissipation so far.
     pub fn dissipated(&self) -> f64 {
-        self.dissipated_normal + self.dissipated_friction + self.dissipated_rolling + self.dissipated_global
+        self.dissipated_normal
+            + self.dissipated_friction
+            + self.dissipated_rolling
+            + self.dissipated_global
     }
 
     /// K_t + K_r.

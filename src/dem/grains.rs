@@ -118,6 +118,9 @@ impl Grains {
 
     /// Total grain area Σ π R².
     pub fn area(&self) -> f64 {
-        self.radius.iter().map(|r| std::f64::consts::PI * r * r).sum()
+        self.radius
+            .iter()
+            .map(|r| std::f64::consts::PI * r * r)
+            .sum()
     }
 }

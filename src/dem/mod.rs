@@ -9,6 +9,7 @@
 //! * [`solver`]: the system [`Dem`] and its velocity-Verlet step;
 //! * [`energy`]: the energy budget;
 //! * [`packing`]: reproducible packings (gravity deposition, hexagonal);
+//! * [`scale`]: the [`crate::scale::Scale`] implementation (sub-cycling `advance`);
 //! * [`validation`]: validation cases (restitution, incline, conservation, energy budget).
 
 pub mod contact;
@@ -16,6 +17,7 @@ pub mod energy;
 pub mod grains;
 pub mod neighbours;
 pub mod packing;
+pub mod scale;
 pub mod solver;
 pub mod validation;
 pub mod walls;

@@ -81,7 +81,10 @@ pub struct Detector {
 impl Detector {
     /// A detector with Verlet skin `skin` (> 0; e.g. 0.1–0.3 of the mean diameter).
     pub fn new(skin: f64) -> Self {
-        Detector { skin, ..Default::default() }
+        Detector {
+            skin,
+            ..Default::default()
+        }
     }
 
     /// Whether some grain moved more than skin/2 since the last build (or there was none).
@@ -96,7 +99,8 @@ impl Detector {
             .with_min_len(4096)
             .any(|((x, y), (x0, y0))| {
                 let (dx, dy) = (x - x0, y - y0);
-                !(dx * dx + dy * dy <= lim)
+                let r2 = dx * dx + dy * dy;
+                r2 > lim || r2.is_nan()
             })
     }
 
@@ -115,7 +119,12 @@ impl Detector {
         let n = g.len();
         let skin = self.skin;
         // Bounding box; grains with non-finite positions are left out of the search.
-        let (mut x0, mut y0, mut x1, mut y1) = (f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
+        let (mut x0, mut y0, mut x1, mut y1) = (
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        );
         for k in 0..n {
             if g.x[k].is_finite() && g.y[k].is_finite() {
                 x0 = x0.min(g.x[k]);
@@ -124,7 +133,7 @@ impl Detector {
                 y1 = y1.max(g.y[k]);
             }
         }
-        if !(x0 <= x1) {
+        if x0 > x1 {
             (x0, y0, x1, y1) = (0.0, 0.0, 0.0, 0.0);
         }
         let mut h = (2.0 * g.max_radius() + skin).max(f64::MIN_POSITIVE);
@@ -175,6 +184,7 @@ impl Detector {
         self.bufs.par_iter_mut().enumerate().for_each(|(k, buf)| {
             buf.clear();
             let mut mine: Vec<u32> = Vec::with_capacity(16);
+            #[allow(clippy::needless_range_loop)]
             for i in k * CHUNK..((k + 1) * CHUNK).min(n) {
                 let c = cell_of[i];
                 if c == u32::MAX {
@@ -266,7 +276,11 @@ impl Detector {
 
     fn build_walls(&mut self, g: &Grains, walls: &[Wall], wl: &mut WallList) {
         let n = g.len();
-        let (old_g, old_w, old_h) = (std::mem::take(&mut wl.grain), std::mem::take(&mut wl.wall), std::mem::take(&mut wl.hist));
+        let (old_g, old_w, old_h) = (
+            std::mem::take(&mut wl.grain),
+            std::mem::take(&mut wl.wall),
+            std::mem::take(&mut wl.hist),
+        );
         let old_p = std::mem::take(&mut wl.prev);
         wl.first.clear();
         wl.first.resize(n + 1, 0);
@@ -279,11 +293,12 @@ impl Detector {
                     while o < old_g.len() && ((old_g[o] as u64) << 32 | old_w[o] as u64) < kp {
                         o += 1;
                     }
-                    let (h, p) = if o < old_g.len() && ((old_g[o] as u64) << 32 | old_w[o] as u64) == kp {
-                        (old_h[o], old_p[o])
-                    } else {
-                        ([0.0; 2], f64::NAN)
-                    };
+                    let (h, p) =
+                        if o < old_g.len() && ((old_g[o] as u64) << 32 | old_w[o] as u64) == kp {
+                            (old_h[o], old_p[o])
+                        } else {
+                            ([0.0; 2], f64::NAN)
+                        };
                     wl.grain.push(k as u32);
                     wl.wall.push(w as u32);
                     wl.hist.push(h);

@@ -60,7 +60,15 @@ impl DemParams {
     /// Parameters with `grain` and `wall` laws, gravity, automatic step, λ = 0.1, skin 0.2 d_max,
     /// no global damping.
     pub fn new(grain: ContactParams, wall: ContactParams, gravity: [f64; 2]) -> Self {
-        DemParams { grain, wall, gravity, dt: None, lambda: 0.1, skin_fraction: 0.2, global_damping: 0.0 }
+        DemParams {
+            grain,
+            wall,
+            gravity,
+            dt: None,
+            lambda: 0.1,
+            skin_fraction: 0.2,
+            global_damping: 0.0,
+        }
     }
 }
 
@@ -111,9 +119,17 @@ fn fractions(delta: f64, prev: f64, v_n: f64, dt: f64) -> [f64; 2] {
     if dt == 0.0 {
         return [1.0, 1.0];
     }
-    let th_in = if prev <= 0.0 { delta / (delta - prev) } else { 1.0 };
+    let th_in = if prev <= 0.0 {
+        delta / (delta - prev)
+    } else {
+        1.0
+    };
     let a_in = (0.5 + th_in).min(1.0);
-    let a_out = if v_n < 0.0 { (0.5 + delta / (-v_n * dt)).min(1.0) } else { 1.0 };
+    let a_out = if v_n < 0.0 {
+        (0.5 + delta / (-v_n * dt)).min(1.0)
+    } else {
+        1.0
+    };
     [th_in, (a_in + a_out - 1.0).clamp(0.0, 1.0)]
 }
 
@@ -205,19 +221,39 @@ impl Dem {
             return Err(Error::config("dem.gravity", "must be finite"));
         }
         if !(params.lambda > 0.0 && params.lambda <= 1.0) {
-            return Err(Error::config("dem.lambda", format!("must be in (0, 1], got {}", params.lambda)));
+            return Err(Error::config(
+                "dem.lambda",
+                format!("must be in (0, 1], got {}", params.lambda),
+            ));
         }
         if !(params.skin_fraction > 0.0 && params.skin_fraction.is_finite()) {
-            return Err(Error::config("dem.skin_fraction", format!("must be > 0, got {}", params.skin_fraction)));
+            return Err(Error::config(
+                "dem.skin_fraction",
+                format!("must be > 0, got {}", params.skin_fraction),
+            ));
         }
         if !(params.global_damping >= 0.0 && params.global_damping.is_finite()) {
-            return Err(Error::config("dem.global_damping", format!("must be ≥ 0, got {}", params.global_damping)));
+            return Err(Error::config(
+                "dem.global_damping",
+                format!("must be ≥ 0, got {}", params.global_damping),
+            ));
         }
         for k in 0..grains.len() {
             let ok = grains.radius[k] > 0.0 && grains.mass[k] > 0.0 && grains.inertia[k] > 0.0;
-            let finite = [grains.x[k], grains.y[k], grains.vx[k], grains.vy[k], grains.omega[k]].iter().all(|v| v.is_finite());
+            let finite = [
+                grains.x[k],
+                grains.y[k],
+                grains.vx[k],
+                grains.vy[k],
+                grains.omega[k],
+            ]
+            .iter()
+            .all(|v| v.is_finite());
             if !ok || !finite {
-                return Err(Error::config(format!("dem.grains[{k}]"), "radius, mass and inertia must be > 0 and the state finite"));
+                return Err(Error::config(
+                    format!("dem.grains[{k}]"),
+                    "radius, mass and inertia must be > 0 and the state finite",
+                ));
             }
         }
         let dt_cr = critical_step(&params, grains.min_mass(), grains.min_inertia());
@@ -238,7 +274,12 @@ impl Dem {
             }
             Some(dt) => dt,
             None if dt_max.is_finite() => dt_max,
-            None => return Err(Error::config("dem.dt", "no grains: give the step explicitly")),
+            None => {
+                return Err(Error::config(
+                    "dem.dt",
+                    "no grains: give the step explicitly",
+                ))
+            }
         };
         let skin = params.skin_fraction * 2.0 * grains.max_radius().max(f64::MIN_POSITIVE);
         Ok(Dem {
@@ -369,7 +410,10 @@ impl Dem {
             let n = self.grains.len();
             for (name, v) in [("fx", &l.fx), ("fy", &l.fy), ("torque", &l.torque)] {
                 if !v.is_empty() && v.len() != n {
-                    return Err(Error::Other(format!("external load `{name}` has {} values for {n} grains", v.len())));
+                    return Err(Error::Other(format!(
+                        "external load `{name}` has {} values for {n} grains",
+                        v.len()
+                    )));
                 }
             }
         }
@@ -383,8 +427,13 @@ impl Dem {
         for _ in 0..n {
             self.step_dt(h, loads);
         }
-        if let Some(i) = (0..self.grains.len()).find(|&i| !(self.grains.x[i].is_finite() && self.grains.y[i].is_finite())) {
-            return Err(Error::Other(format!("DEM unstable at step {} (t = {:.6e} s): grain {i} has a non-finite position", self.steps, self.time)));
+        if let Some(i) = (0..self.grains.len())
+            .find(|&i| !(self.grains.x[i].is_finite() && self.grains.y[i].is_finite()))
+        {
+            return Err(Error::Other(format!(
+                "DEM unstable at step {} (t = {:.6e} s): grain {i} has a non-finite position",
+                self.steps, self.time
+            )));
         }
         Ok(())
     }
@@ -461,7 +510,12 @@ impl Dem {
     /// `dt_hist` (0: evaluate without advancing), dissipation accrues over `dt_hist`.
     fn compute_forces(&mut self, dt_hist: f64, loads: Option<&ExternalLoads>) {
         if self.detector.needs_rebuild(&self.grains) {
-            self.detector.build(&self.grains, &self.walls, &mut self.pairs, &mut self.wall_pairs);
+            self.detector.build(
+                &self.grains,
+                &self.walls,
+                &mut self.pairs,
+                &mut self.wall_pairs,
+            );
         }
         if dt_hist == 0.0 || self.vxp.len() != self.grains.len() {
             self.vxp.clone_from(&self.grains.vx);
@@ -494,7 +548,11 @@ impl Dem {
                         continue;
                     }
                     let d = d2.sqrt();
-                    let (nx, ny) = if d > 0.0 { (dx / d, dy / d) } else { (1.0, 0.0) };
+                    let (nx, ny) = if d > 0.0 {
+                        (dx / d, dy / d)
+                    } else {
+                        (1.0, 0.0)
+                    };
                     let (tx, ty) = (-ny, nx);
                     let (dvx, dvy) = (g.vx[i] - g.vx[j], g.vy[i] - g.vy[j]);
                     let (wi, wj) = (g.omega[i], g.omega[j]);
@@ -506,7 +564,17 @@ impl Dem {
                     let (mi, mj) = (g.mass[i], g.mass[j]);
                     let frac = fractions(rs - d, prev[k], v_n, dt_hist);
                     prev[k] = rs - d;
-                    let r = law.resolve(rs - d, v_n, [v_t, v_t1], [wi - wj, pi_ - pj_], mi * mj / (mi + mj), ri * rj / rs, &mut hist[k], dt_hist, frac);
+                    let r = law.resolve(
+                        rs - d,
+                        v_n,
+                        [v_t, v_t1],
+                        [wi - wj, pi_ - pj_],
+                        mi * mj / (mi + mj),
+                        ri * rj / rs,
+                        &mut hist[k],
+                        dt_hist,
+                        frac,
+                    );
                     out[k] = [
                         -r.f_n * nx + r.f_t * tx,
                         -r.f_n * ny + r.f_t * ty,
@@ -549,8 +617,22 @@ impl Dem {
                     let v_t1 = vxp[i] * tx + vyp[i] * ty + w1 * ri;
                     let frac = fractions(ri - s, prev[k], v_n, dt_hist);
                     prev[k] = ri - s;
-                    let r = wlaw.resolve(ri - s, v_n, [v_t, v_t1], [w, w1], g.mass[i], ri, &mut hist[k], dt_hist, frac);
-                    out[k] = [-r.f_n * nx + r.f_t * tx, -r.f_n * ny + r.f_t * ty, ri * r.f_t + r.m_r];
+                    let r = wlaw.resolve(
+                        ri - s,
+                        v_n,
+                        [v_t, v_t1],
+                        [w, w1],
+                        g.mass[i],
+                        ri,
+                        &mut hist[k],
+                        dt_hist,
+                        frac,
+                    );
+                    out[k] = [
+                        -r.f_n * nx + r.f_t * tx,
+                        -r.f_n * ny + r.f_t * ty,
+                        ri * r.f_t + r.m_r,
+                    ];
                     part = part.add(&r);
                 }
                 part
@@ -578,7 +660,10 @@ impl Dem {
                 for k in 0..fx.len() {
                     let i = o + k;
                     let (vx, vy, w) = (x_vx[i], x_vy[i], x_w[i]);
-                    let mut f = [m[i] * grav[0] - alpha * m[i] * vx, m[i] * grav[1] - alpha * m[i] * vy];
+                    let mut f = [
+                        m[i] * grav[0] - alpha * m[i] * vx,
+                        m[i] * grav[1] - alpha * m[i] * vy,
+                    ];
                     let mut t = 0.0;
                     d_glob += alpha * m[i] * (vx * vx + vy * vy);
                     if !lx.is_empty() {
@@ -622,7 +707,10 @@ impl Dem {
                 [d_glob, w_ext]
             })
             .collect_into_vec(&mut self.gparts);
-        let (d_glob, w_ext) = self.gparts.iter().fold((0.0, 0.0), |a, b| (a.0 + b[0], a.1 + b[1]));
+        let (d_glob, w_ext) = self
+            .gparts
+            .iter()
+            .fold((0.0, 0.0), |a, b| (a.0 + b[0], a.1 + b[1]));
         let b = &mut self.budget;
         b.elastic_normal = total.e_n;
         b.elastic_tangential = total.e_t;

@@ -29,17 +29,26 @@ pub enum Wall {
 impl Wall {
     /// Floor y = `y0` (grains above).
     pub fn floor(y0: f64) -> Self {
-        Wall::Plane { point: [0.0, y0], normal: [0.0, 1.0] }
+        Wall::Plane {
+            point: [0.0, y0],
+            normal: [0.0, 1.0],
+        }
     }
 
     /// Left wall x = `x0` (grains to its right).
     pub fn left(x0: f64) -> Self {
-        Wall::Plane { point: [x0, 0.0], normal: [1.0, 0.0] }
+        Wall::Plane {
+            point: [x0, 0.0],
+            normal: [1.0, 0.0],
+        }
     }
 
     /// Right wall x = `x1` (grains to its left).
     pub fn right(x1: f64) -> Self {
-        Wall::Plane { point: [x1, 0.0], normal: [-1.0, 0.0] }
+        Wall::Plane {
+            point: [x1, 0.0],
+            normal: [-1.0, 0.0],
+        }
     }
 
     /// Distance s from `c` to the wall and the unit normal **n** from `c` towards it.
@@ -77,12 +86,18 @@ impl Wall {
             Wall::Plane { point, normal } => {
                 let n = (normal[0] * normal[0] + normal[1] * normal[1]).sqrt();
                 if !(point.iter().all(|v| v.is_finite()) && (n - 1.0).abs() < 1e-9) {
-                    return Err(crate::Error::config(field, format!("plane needs a finite point and a unit normal, got |n| = {n}")));
+                    return Err(crate::Error::config(
+                        field,
+                        format!("plane needs a finite point and a unit normal, got |n| = {n}"),
+                    ));
                 }
             }
             Wall::Segment { a, b } => {
                 if !(a.iter().chain(b.iter()).all(|v| v.is_finite()) && a != b) {
-                    return Err(crate::Error::config(field, "segment needs two distinct finite end points"));
+                    return Err(crate::Error::config(
+                        field,
+                        "segment needs two distinct finite end points",
+                    ));
                 }
             }
         }
@@ -96,7 +111,10 @@ mod tests {
 
     #[test]
     fn segment_distance_and_normal() {
-        let w = Wall::Segment { a: [0.0, 0.0], b: [2.0, 0.0] };
+        let w = Wall::Segment {
+            a: [0.0, 0.0],
+            b: [2.0, 0.0],
+        };
         let (s, n) = w.distance([1.0, 0.5]);
         assert!((s - 0.5).abs() < 1e-15 && n == [0.0, -1.0]);
         let (s, _) = w.distance([3.0, 0.0]);

@@ -13,6 +13,7 @@
 
 use rayon::prelude::*;
 
+use super::contact::ContactState;
 use super::grains::Grains;
 use super::walls::Wall;
 
@@ -26,12 +27,10 @@ pub struct PairList {
     pub i: Vec<u32>,
     /// Second grain of each pair.
     pub j: Vec<u32>,
-    /// History [ξ_t, θ_r] of each pair (zero when not touching).
-    pub hist: Vec<[f64; 2]>,
-    /// Overlap δ at the previous force evaluation (negative: gap; NaN: unknown).
-    pub prev: Vec<f64>,
-    /// Last forces of each pair: [F_x on i, F_y on i, torque on i, torque on j]
-    /// (the force on j is the opposite).
+    /// Contact state of each pair: last overlap, springs, forces (see [`ContactState`]).
+    pub state: Vec<ContactState>,
+    /// Forces of each pair applied in the last second half-kick: [F_x on i, F_y on i,
+    /// torque on i, torque on j] (the force on j is the opposite).
     pub out: Vec<[f64; 4]>,
     /// Pairs whose first grain is `g` are `first[g]..first[g + 1]`.
     pub first: Vec<u32>,
@@ -48,11 +47,9 @@ pub struct WallList {
     pub grain: Vec<u32>,
     /// Wall index of each pair.
     pub wall: Vec<u32>,
-    /// History [ξ_t, θ_r].
-    pub hist: Vec<[f64; 2]>,
-    /// Overlap at the previous force evaluation (NaN: unknown).
-    pub prev: Vec<f64>,
-    /// Last [F_x, F_y, torque] on the grain.
+    /// Contact state of each pair.
+    pub state: Vec<ContactState>,
+    /// [F_x, F_y, torque] on the grain applied in the last second half-kick.
     pub out: Vec<[f64; 3]>,
     /// Pairs of grain `g` are `first[g]..first[g + 1]`.
     pub first: Vec<u32>,
@@ -69,8 +66,7 @@ pub struct Detector {
     bufs: Vec<Vec<(u32, u32)>>,
     old_i: Vec<u32>,
     old_j: Vec<u32>,
-    old_hist: Vec<[f64; 2]>,
-    old_prev: Vec<f64>,
+    old_state: Vec<ContactState>,
     /// Positions at the last build.
     x_ref: Vec<f64>,
     y_ref: Vec<f64>,
@@ -216,12 +212,10 @@ impl Detector {
         // Keep the old list for the history merge.
         std::mem::swap(&mut self.old_i, &mut pl.i);
         std::mem::swap(&mut self.old_j, &mut pl.j);
-        std::mem::swap(&mut self.old_hist, &mut pl.hist);
-        std::mem::swap(&mut self.old_prev, &mut pl.prev);
+        std::mem::swap(&mut self.old_state, &mut pl.state);
         pl.i.clear();
         pl.j.clear();
-        pl.hist.clear();
-        pl.prev.clear();
+        pl.state.clear();
         for buf in &self.bufs {
             for &(i, j) in buf {
                 pl.i.push(i);
@@ -229,8 +223,7 @@ impl Detector {
             }
         }
         let m = pl.i.len();
-        pl.hist.resize(m, [0.0; 2]);
-        pl.prev.resize(m, f64::NAN);
+        pl.state.resize(m, ContactState::default());
         // Merge history: both lists sorted by (i, j).
         let key = |i: u32, j: u32| (u64::from(i) << 32) | u64::from(j);
         let mut o = 0;
@@ -240,8 +233,7 @@ impl Detector {
                 o += 1;
             }
             if o < self.old_i.len() && key(self.old_i[o], self.old_j[o]) == kp {
-                pl.hist[p] = self.old_hist[o];
-                pl.prev[p] = self.old_prev[o];
+                pl.state[p] = self.old_state[o];
             }
         }
         pl.out.clear();
@@ -276,12 +268,11 @@ impl Detector {
 
     fn build_walls(&mut self, g: &Grains, walls: &[Wall], wl: &mut WallList) {
         let n = g.len();
-        let (old_g, old_w, old_h) = (
+        let (old_g, old_w, old_s) = (
             std::mem::take(&mut wl.grain),
             std::mem::take(&mut wl.wall),
-            std::mem::take(&mut wl.hist),
+            std::mem::take(&mut wl.state),
         );
-        let old_p = std::mem::take(&mut wl.prev);
         wl.first.clear();
         wl.first.resize(n + 1, 0);
         let mut o = 0;
@@ -293,16 +284,15 @@ impl Detector {
                     while o < old_g.len() && ((old_g[o] as u64) << 32 | old_w[o] as u64) < kp {
                         o += 1;
                     }
-                    let (h, p) =
+                    let st =
                         if o < old_g.len() && ((old_g[o] as u64) << 32 | old_w[o] as u64) == kp {
-                            (old_h[o], old_p[o])
+                            old_s[o]
                         } else {
-                            ([0.0; 2], f64::NAN)
+                            ContactState::default()
                         };
                     wl.grain.push(k as u32);
                     wl.wall.push(w as u32);
-                    wl.hist.push(h);
-                    wl.prev.push(p);
+                    wl.state.push(st);
                 }
             }
             wl.first[k + 1] = wl.grain.len() as u32;

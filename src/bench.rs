@@ -48,13 +48,29 @@ fn median(v: &mut [f64]) -> f64 {
     v[v.len() / 2]
 }
 
-fn time_lbm<T: Real>(nx: usize, ny: usize, steps: u64, mrt: bool, repeats: usize) -> Result<Vec<f64>> {
-    let mut lat = Lattice::<T>::new(nx, ny, Edges::periodic(), vec![false; nx * ny]).map_err(Error::Other)?;
+fn time_lbm<T: Real>(
+    nx: usize,
+    ny: usize,
+    steps: u64,
+    mrt: bool,
+    repeats: usize,
+) -> Result<Vec<f64>> {
+    let mut lat =
+        Lattice::<T>::new(nx, ny, Edges::periodic(), vec![false; nx * ny]).map_err(Error::Other)?;
     let k = 2.0 * std::f64::consts::PI / ny as f64;
     lat.fill(|_, y| (1.0, 0.05 * (k * (y as f64 + 0.5)).sin(), 0.0));
     let tau = 0.6;
-    let model = if mrt { CollisionModel::Mrt(MrtRates::standard(tau)) } else { CollisionModel::Bgk };
-    let mut lbm = Lbm::new(lat, Collider::new(model, tau, None, [0.0; 2]), Obstacles::default(), Units::new(1.0, 1.0, 1.0));
+    let model = if mrt {
+        CollisionModel::Mrt(MrtRates::standard(tau))
+    } else {
+        CollisionModel::Bgk
+    };
+    let mut lbm = Lbm::new(
+        lat,
+        Collider::new(model, tau, None, [0.0; 2]),
+        Obstacles::default(),
+        Units::new(1.0, 1.0, 1.0),
+    );
     lbm.step();
     lbm.step();
     let mut out = Vec::new();
@@ -66,7 +82,9 @@ fn time_lbm<T: Real>(nx: usize, ny: usize, steps: u64, mrt: bool, repeats: usize
         out.push((nx * ny) as f64 * steps as f64 / t0.elapsed().as_secs_f64() / 1e6);
     }
     if let Some((c, why)) = lbm.find_instability(0.5) {
-        return Err(Error::Other(format!("benchmark went unstable at cell {c}: {why}")));
+        return Err(Error::Other(format!(
+            "benchmark went unstable at cell {c}: {why}"
+        )));
     }
     Ok(out)
 }
@@ -80,7 +98,9 @@ pub fn copy_bandwidth(bytes: usize) -> f64 {
     let mut best: f64 = 0.0;
     for _ in 0..5 {
         let t0 = Instant::now();
-        dst.par_chunks_mut(chunk).zip(src.par_chunks(chunk)).for_each(|(d, s)| d.copy_from_slice(s));
+        dst.par_chunks_mut(chunk)
+            .zip(src.par_chunks(chunk))
+            .for_each(|(d, s)| d.copy_from_slice(s));
         let dt = t0.elapsed().as_secs_f64();
         best = best.max(2.0 * (n * 8) as f64 / dt / 1e9);
     }
@@ -89,9 +109,19 @@ pub fn copy_bandwidth(bytes: usize) -> f64 {
 }
 
 /// Run the LBM benchmark on `threads` threads (0: rayon's default).
-pub fn lbm(nx: usize, ny: usize, steps: u64, f64_: bool, mrt: bool, threads: usize, repeats: usize) -> Result<LbmBench> {
+pub fn lbm(
+    nx: usize,
+    ny: usize,
+    steps: u64,
+    f64_: bool,
+    mrt: bool,
+    threads: usize,
+    repeats: usize,
+) -> Result<LbmBench> {
     if nx < 3 || ny < 3 || steps == 0 || repeats == 0 {
-        return Err(Error::Other("bench lbm: need nx, ny ≥ 3 and steps, repeats ≥ 1".into()));
+        return Err(Error::Other(
+            "bench lbm: need nx, ny ≥ 3 and steps, repeats ≥ 1".into(),
+        ));
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)

@@ -11,7 +11,11 @@ use granflow::config::Scenario;
 use granflow::validate::{self, Check, Fidelity};
 
 #[derive(Parser)]
-#[command(name = "granflow", version, about = "Multi-scale granular flows, dry and submerged")]
+#[command(
+    name = "granflow",
+    version,
+    about = "Multi-scale granular flows, dry and submerged"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -117,24 +121,55 @@ fn check(path: &PathBuf) -> Result<ExitCode> {
     let d = s.derive()?;
     let u = &d.units;
     println!("scenario        {} — {}", s.name, s.description);
-    println!("cells           {} × {} = {}", d.cells[0], d.cells[1], d.cells[0] * d.cells[1]);
+    println!(
+        "cells           {} × {} = {}",
+        d.cells[0],
+        d.cells[1],
+        d.cells[0] * d.cells[1]
+    );
     println!("dx              {:.6e} m", u.dx);
     println!("dt              {:.6e} s", u.dt);
     println!("tau             {:.6}", d.tau);
     println!("nu (lattice)    {:.6e}", d.nu_lattice);
     println!("u_ref (lattice) {:.6e}", d.u_lattice);
-    println!("Mach (lattice)  {:.4}  (limit {})", d.mach, granflow::config::MAX_MACH);
+    println!(
+        "Mach (lattice)  {:.4}  (limit {})",
+        d.mach,
+        granflow::config::MAX_MACH
+    );
     println!("Reynolds        {:.4}", d.reynolds);
     println!("steps           {} ({} s)", d.steps, s.time.end);
-    println!("frames          every {} steps ({} frames)", d.frame_every, d.steps.div_ceil(d.frame_every) + 1);
+    println!(
+        "frames          every {} steps ({} frames)",
+        d.frame_every,
+        d.steps.div_ceil(d.frame_every) + 1
+    );
     println!("series          every {} steps", d.series_every);
-    println!("force (lattice) [{:.4e}, {:.4e}]", d.force_lattice[0], d.force_lattice[1]);
-    println!("collision       {:?}{}", s.lbm.collision, s.lbm.smagorinsky.map_or(String::new(), |c| format!(" + Smagorinsky C = {c}")));
+    println!(
+        "force (lattice) [{:.4e}, {:.4e}]",
+        d.force_lattice[0], d.force_lattice[1]
+    );
+    println!(
+        "collision       {:?}{}",
+        s.lbm.collision,
+        s.lbm
+            .smagorinsky
+            .map_or(String::new(), |c| format!(" + Smagorinsky C = {c}"))
+    );
     if let Some(r) = d.mrt {
-        println!("MRT rates       s_e = {:.4}, s_eps = {:.4}, s_q = {:.4}, s_nu = {:.4}", r.s_e, r.s_eps, r.s_q, 1.0 / d.tau);
+        println!(
+            "MRT rates       s_e = {:.4}, s_eps = {:.4}, s_q = {:.4}, s_nu = {:.4}",
+            r.s_e,
+            r.s_eps,
+            r.s_q,
+            1.0 / d.tau
+        );
     }
     println!("precision       {:?}", s.lbm.precision);
-    println!("memory          {:.1} MiB (populations)", d.memory_bytes as f64 / (1 << 20) as f64);
+    println!(
+        "memory          {:.1} MiB (populations)",
+        d.memory_bytes as f64 / (1 << 20) as f64
+    );
     println!("obstacles       {}", s.obstacles.len());
     println!("ok");
     Ok(ExitCode::SUCCESS)
@@ -145,13 +180,22 @@ fn run(path: &PathBuf, out: &PathBuf) -> Result<ExitCode> {
     let d = s.derive()?;
     eprintln!(
         "{}: {} × {} cells, τ = {:.4}, Mach {:.3}, Re {:.1}, {} steps -> {}",
-        s.name, d.cells[0], d.cells[1], d.tau, d.mach, d.reynolds, d.steps, out.display()
+        s.name,
+        d.cells[0],
+        d.cells[1],
+        d.tau,
+        d.mach,
+        d.reynolds,
+        d.steps,
+        out.display()
     );
     let summary = if std::io::stderr().is_terminal() {
         let bar = indicatif::ProgressBar::new(d.steps);
         bar.set_style(
-            indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} steps, eta {eta}")
-                .expect("valid template"),
+            indicatif::ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:40}] {pos}/{len} steps, eta {eta}",
+            )
+            .expect("valid template"),
         );
         let r = granflow::run::run(&s, out, &mut |i, _| bar.set_position(i));
         bar.finish();
@@ -166,7 +210,13 @@ fn run(path: &PathBuf, out: &PathBuf) -> Result<ExitCode> {
             }
         })
     }
-    .with_context(|| format!("run of {} stopped; frames written so far are in {}", path.display(), out.display()))?;
+    .with_context(|| {
+        format!(
+            "run of {} stopped; frames written so far are in {}",
+            path.display(),
+            out.display()
+        )
+    })?;
     println!(
         "done: {} steps, {:.1} s simulated, {} frames, {:.1} s wall, {:.1} MLUPS, mass drift {:.2e}",
         summary.steps, summary.time, summary.frames, summary.wall_seconds, summary.mlups, summary.mass_drift
@@ -179,7 +229,8 @@ fn run(path: &PathBuf, out: &PathBuf) -> Result<ExitCode> {
             o.force[1],
             o.coefficients[0],
             o.coefficients[1],
-            o.strouhal.map_or(String::new(), |st| format!(", St = {st:.4}"))
+            o.strouhal
+                .map_or(String::new(), |st| format!(", St = {st:.4}"))
         );
     }
     Ok(ExitCode::SUCCESS)
@@ -209,7 +260,11 @@ fn validate_cmd(case: &str, json: bool, full: bool) -> Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let fidelity = if full { Fidelity::Full } else { Fidelity::Test };
-    let names: Vec<&str> = if case == "all" { validate::CASES.iter().map(|c| c.name).collect() } else { vec![case] };
+    let names: Vec<&str> = if case == "all" {
+        validate::CASES.iter().map(|c| c.name).collect()
+    } else {
+        vec![case]
+    };
     let mut failed = 0;
     for name in names {
         match validate::run(name, fidelity) {
@@ -222,19 +277,35 @@ fn validate_cmd(case: &str, json: bool, full: bool) -> Result<ExitCode> {
             Err(e) => {
                 failed += 1;
                 if json {
-                    println!("{}", serde_json::json!({"case": name, "error": e.to_string(), "pass": false}));
+                    println!(
+                        "{}",
+                        serde_json::json!({"case": name, "error": e.to_string(), "pass": false})
+                    );
                 } else {
                     println!("ERROR {name}: {e}");
                 }
             }
         }
     }
-    Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+    Ok(if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
 }
 
 fn bench(which: Bench) -> Result<ExitCode> {
     match which {
-        Bench::Lbm { nx, ny, steps, precision, collision, threads, repeats, json } => {
+        Bench::Lbm {
+            nx,
+            ny,
+            steps,
+            precision,
+            collision,
+            threads,
+            repeats,
+            json,
+        } => {
             let r = granflow::bench::lbm(
                 nx,
                 ny,

@@ -76,7 +76,11 @@ pub fn run(scenario: &Scenario, out: &Path, progress: Progress) -> Result<Summar
     let (mut fluid, derived) = scenario.build()?;
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let mut state = Outputs::create(scenario, &derived, out)?;
-    let names: Vec<String> = scenario.lattice_obstacles(&derived.units).into_iter().map(|o| o.name).collect();
+    let names: Vec<String> = scenario
+        .lattice_obstacles(&derived.units)
+        .into_iter()
+        .map(|o| o.name)
+        .collect();
     let mass0 = fluid.total_mass();
     let start = Instant::now();
     let total = derived.steps;
@@ -102,7 +106,11 @@ pub fn run(scenario: &Scenario, out: &Path, progress: Progress) -> Result<Summar
             break;
         }
         if s % derived.series_every == 0 || s == total {
-            state.record(fluid.as_ref(), &mut macro_, s % derived.frame_every == 0 || s == total)?;
+            state.record(
+                fluid.as_ref(),
+                &mut macro_,
+                s % derived.frame_every == 0 || s == total,
+            )?;
             if s * 2 >= total {
                 lift.push(fluid.obstacle_loads().0.first().map_or(0.0, |f| f[1]));
             }
@@ -115,7 +123,11 @@ pub fn run(scenario: &Scenario, out: &Path, progress: Progress) -> Result<Summar
     let cells = (derived.cells[0] * derived.cells[1]) as f64;
     let (forces, torques) = fluid.obstacle_loads();
     let u = &derived.units;
-    let (uref, lref, rho) = (scenario.reference.velocity, scenario.reference.length, scenario.fluid.density);
+    let (uref, lref, rho) = (
+        scenario.reference.velocity,
+        scenario.reference.length,
+        scenario.fluid.density,
+    );
     let series_dt = derived.series_every as f64 * u.dt;
     let obstacles = names
         .into_iter()
@@ -169,18 +181,28 @@ struct Outputs {
 
 impl Outputs {
     fn create(scenario: &Scenario, derived: &Derived, dir: &Path) -> Result<Self> {
-        let mut header: Vec<String> =
-            ["t", "step", "mass", "kinetic_energy", "max_speed"].iter().map(|s| s.to_string()).collect();
+        let mut header: Vec<String> = ["t", "step", "mass", "kinetic_energy", "max_speed"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
         for ob in &scenario.obstacles {
             let name = match ob {
                 crate::config::ObstacleSpec::Circle { name, .. }
                 | crate::config::ObstacleSpec::Rectangle { name, .. }
                 | crate::config::ObstacleSpec::Polygon { name, .. } => name,
             };
-            header.extend([format!("{name}_fx"), format!("{name}_fy"), format!("{name}_torque")]);
+            header.extend([
+                format!("{name}_fx"),
+                format!("{name}_fy"),
+                format!("{name}_torque"),
+            ]);
         }
         for p in &scenario.probes {
-            header.extend([format!("{}_p", p.name), format!("{}_ux", p.name), format!("{}_uy", p.name)]);
+            header.extend([
+                format!("{}_p", p.name),
+                format!("{}_ux", p.name),
+                format!("{}_uy", p.name),
+            ]);
         }
         let header: Vec<&str> = header.iter().map(String::as_str).collect();
         Ok(Outputs {
@@ -189,7 +211,11 @@ impl Outputs {
             rho0: scenario.fluid.density,
             series: CsvWriter::create(&dir.join("timeseries.csv"), &header)?,
             pvd: PvdSeries::new(dir),
-            probes: scenario.probes.iter().map(|p| scenario.cell_at(derived, p.position)).collect(),
+            probes: scenario
+                .probes
+                .iter()
+                .map(|p| scenario.cell_at(derived, p.position))
+                .collect(),
             frames: 0,
         })
     }
@@ -199,7 +225,10 @@ impl Outputs {
         let u = self.derived.units;
         fluid.macroscopic(m);
         let t = fluid.step_count() as f64 * u.dt;
-        let mass: f64 = (0..m.rho.len()).filter(|&c| !m.solid[c]).map(|c| m.rho[c]).sum();
+        let mass: f64 = (0..m.rho.len())
+            .filter(|&c| !m.solid[c])
+            .map(|c| m.rho[c])
+            .sum();
         let cell_area = u.dx * u.dx;
         let mut ke = 0.0;
         let mut umax: f64 = 0.0;
@@ -218,7 +247,11 @@ impl Outputs {
         ];
         let (forces, torques) = fluid.obstacle_loads();
         for (f, tq) in forces.iter().zip(&torques) {
-            row.extend([u.force_to_si(f[0]), u.force_to_si(f[1]), u.torque_to_si(*tq)]);
+            row.extend([
+                u.force_to_si(f[0]),
+                u.force_to_si(f[1]),
+                u.torque_to_si(*tq),
+            ]);
         }
         for &c in &self.probes {
             row.extend([u.pressure_to_si(m.rho[c]), m.ux[c] * v, m.uy[c] * v]);
@@ -235,10 +268,19 @@ impl Outputs {
         let v = u.velocity_to_si(1.0);
         let density: Vec<f64> = m.rho.iter().map(|&r| u.density_to_si(r)).collect();
         let pressure: Vec<f64> = m.rho.iter().map(|&r| u.pressure_to_si(r)).collect();
-        let velocity: Vec<[f64; 2]> = m.ux.iter().zip(&m.uy).map(|(a, b)| [a * v, b * v]).collect();
+        let velocity: Vec<[f64; 2]> =
+            m.ux.iter()
+                .zip(&m.uy)
+                .map(|(a, b)| [a * v, b * v])
+                .collect();
         let vorticity: Vec<f64> = m.vorticity().into_iter().map(|w| u.rate_to_si(w)).collect();
         let solid: Vec<f64> = m.solid.iter().map(|&s| if s { 1.0 } else { 0.0 }).collect();
-        let grid = ImageGrid { nx: m.nx, ny: m.ny, origin: [0.0, 0.0], spacing: [u.dx, u.dx] };
+        let grid = ImageGrid {
+            nx: m.nx,
+            ny: m.ny,
+            origin: [0.0, 0.0],
+            spacing: [u.dx, u.dx],
+        };
         let file = format!("fluid_{:06}.vti", self.frames);
         write_vti(
             &self.dir.join(&file),

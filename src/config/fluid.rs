@@ -274,7 +274,10 @@ fn positive(field: &str, v: f64) -> Result<()> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
-        Err(Error::config(field, format!("must be a positive number, got {v}")))
+        Err(Error::config(
+            field,
+            format!("must be a positive number, got {v}"),
+        ))
     }
 }
 
@@ -296,7 +299,10 @@ fn inside(field: &str, p: [f64; 2], size: [f64; 2]) -> Result<()> {
     } else {
         Err(Error::config(
             field,
-            format!("point ({}, {}) m lies outside the domain [0, {}] × [0, {}] m", p[0], p[1], size[0], size[1]),
+            format!(
+                "point ({}, {}) m lies outside the domain [0, {}] × [0, {}] m",
+                p[0], p[1], size[0], size[1]
+            ),
         ))
     }
 }
@@ -315,7 +321,10 @@ impl Scenario {
         let units = match (self.time.tau, self.time.dt) {
             (Some(tau), None) => {
                 if !(tau > 0.5 && tau.is_finite()) {
-                    return Err(Error::config("time.tau", format!("τ = {tau} must exceed ½ (ν = (τ − ½)/3 > 0)")));
+                    return Err(Error::config(
+                        "time.tau",
+                        format!("τ = {tau} must exceed ½ (ν = (τ − ½)/3 > 0)"),
+                    ));
                 }
                 Units::from_tau(dx, tau, nu, rho)
             }
@@ -330,7 +339,10 @@ impl Scenario {
             return Err(Error::config("time.dt", format!("gives τ = {tau} ≤ ½")));
         }
         if tau > 1e3 {
-            return Err(Error::config("time.dt", format!("gives τ = {tau:.3e}: the time step is far too large for this viscosity")));
+            return Err(Error::config(
+                "time.dt",
+                format!("gives τ = {tau:.3e}: the time step is far too large for this viscosity"),
+            ));
         }
         positive("time.end", self.time.end)?;
         positive("time.frame_interval", self.time.frame_interval)?;
@@ -355,7 +367,10 @@ impl Scenario {
                 return Err(Error::config(field, "must be finite"));
             }
             if m > MAX_MACH {
-                return Err(Error::config(field, format!("lattice Mach number {m:.3} > {MAX_MACH}")));
+                return Err(Error::config(
+                    field,
+                    format!("lattice Mach number {m:.3} > {MAX_MACH}"),
+                ));
             }
             Ok(())
         };
@@ -366,33 +381,55 @@ impl Scenario {
                     check_u(&format!("boundaries.{name}.velocity"), *velocity)?
                 }
                 EdgeSpec::Pressure { pressure } if !pressure.is_finite() => {
-                    return Err(Error::config(format!("boundaries.{name}.pressure"), "must be finite"))
+                    return Err(Error::config(
+                        format!("boundaries.{name}.pressure"),
+                        "must be finite",
+                    ))
                 }
                 _ => {}
             }
         }
         let edges = self.edges(&units, nx, ny)?;
-        edges.check().map_err(|(f, why)| Error::config(format!("boundaries.{f}"), why))?;
+        edges
+            .check()
+            .map_err(|(f, why)| Error::config(format!("boundaries.{f}"), why))?;
         if let Some(c) = self.lbm.smagorinsky {
             if !(c.is_finite() && c >= 0.0) {
-                return Err(Error::config("lbm.smagorinsky", format!("must be ≥ 0, got {c}")));
+                return Err(Error::config(
+                    "lbm.smagorinsky",
+                    format!("must be ≥ 0, got {c}"),
+                ));
             }
         }
         let mrt = match self.lbm.collision {
             CollisionKind::Bgk => {
                 if self.lbm.mrt.is_some() {
-                    return Err(Error::config("lbm.mrt", "MRT rates given but lbm.collision = \"bgk\""));
+                    return Err(Error::config(
+                        "lbm.mrt",
+                        "MRT rates given but lbm.collision = \"bgk\"",
+                    ));
                 }
                 None
             }
             CollisionKind::Mrt => {
                 let r = match self.lbm.mrt {
-                    Some(m) => MrtRates { s_e: m.s_e, s_eps: m.s_eps, s_q: m.s_q },
+                    Some(m) => MrtRates {
+                        s_e: m.s_e,
+                        s_eps: m.s_eps,
+                        s_q: m.s_q,
+                    },
                     None => MrtRates::standard(tau),
                 };
-                for (f, v) in [("lbm.mrt.s_e", r.s_e), ("lbm.mrt.s_eps", r.s_eps), ("lbm.mrt.s_q", r.s_q)] {
+                for (f, v) in [
+                    ("lbm.mrt.s_e", r.s_e),
+                    ("lbm.mrt.s_eps", r.s_eps),
+                    ("lbm.mrt.s_q", r.s_q),
+                ] {
                     if !(v > 0.0 && v < 2.0) {
-                        return Err(Error::config(f, format!("relaxation rate {v} must lie in (0, 2)")));
+                        return Err(Error::config(
+                            f,
+                            format!("relaxation rate {v} must lie in (0, 2)"),
+                        ));
                     }
                 }
                 Some(r)
@@ -414,12 +451,18 @@ impl Scenario {
                     inside(&format!("{field}.min"), *min, self.domain.size)?;
                     inside(&format!("{field}.max"), *max, self.domain.size)?;
                     if !(max[0] > min[0] && max[1] > min[1]) {
-                        return Err(Error::config(format!("{field}.max"), "must exceed min in x and y"));
+                        return Err(Error::config(
+                            format!("{field}.max"),
+                            "must exceed min in x and y",
+                        ));
                     }
                 }
                 ObstacleSpec::Polygon { vertices, .. } => {
                     if vertices.len() < 3 {
-                        return Err(Error::config(format!("{field}.vertices"), "a polygon needs at least 3 vertices"));
+                        return Err(Error::config(
+                            format!("{field}.vertices"),
+                            "a polygon needs at least 3 vertices",
+                        ));
                     }
                     for (j, v) in vertices.iter().enumerate() {
                         inside(&format!("{field}.vertices[{j}]"), *v, self.domain.size)?;
@@ -428,7 +471,11 @@ impl Scenario {
             }
         }
         for (k, p) in self.probes.iter().enumerate() {
-            inside(&format!("probes[{k}].position"), p.position, self.domain.size)?;
+            inside(
+                &format!("probes[{k}].position"),
+                p.position,
+                self.domain.size,
+            )?;
         }
         let force_lattice = [
             units.acceleration_to_lattice(self.body_acceleration[0]),
@@ -467,7 +514,12 @@ impl Scenario {
 
     fn edges_named(&self) -> [(&'static str, &EdgeSpec); 4] {
         let b = &self.boundaries;
-        [("left", &b.left), ("right", &b.right), ("bottom", &b.bottom), ("top", &b.top)]
+        [
+            ("left", &b.left),
+            ("right", &b.right),
+            ("bottom", &b.bottom),
+            ("top", &b.top),
+        ]
     }
 
     /// The edge conditions in lattice units.
@@ -477,10 +529,16 @@ impl Scenario {
                 EdgeSpec::Periodic => Edge::Periodic,
                 EdgeSpec::Wall => Edge::Wall { velocity: [0.0; 2] },
                 EdgeSpec::MovingWall { velocity } => Edge::Wall {
-                    velocity: [units.velocity_to_lattice(velocity[0]), units.velocity_to_lattice(velocity[1])],
+                    velocity: [
+                        units.velocity_to_lattice(velocity[0]),
+                        units.velocity_to_lattice(velocity[1]),
+                    ],
                 },
                 EdgeSpec::Velocity { velocity, profile } => {
-                    let u = [units.velocity_to_lattice(velocity[0]), units.velocity_to_lattice(velocity[1])];
+                    let u = [
+                        units.velocity_to_lattice(velocity[0]),
+                        units.velocity_to_lattice(velocity[1]),
+                    ];
                     Edge::Velocity(
                         (0..len)
                             .map(|k| {
@@ -497,11 +555,18 @@ impl Scenario {
                             .collect(),
                     )
                 }
-                EdgeSpec::Pressure { pressure } => Edge::Pressure(units.pressure_to_lattice_density(*pressure)),
+                EdgeSpec::Pressure { pressure } => {
+                    Edge::Pressure(units.pressure_to_lattice_density(*pressure))
+                }
             }
         };
         let b = &self.boundaries;
-        Ok(Edges { left: conv(&b.left, ny), right: conv(&b.right, ny), bottom: conv(&b.bottom, nx), top: conv(&b.top, nx) })
+        Ok(Edges {
+            left: conv(&b.left, ny),
+            right: conv(&b.right, ny),
+            bottom: conv(&b.bottom, nx),
+            top: conv(&b.top, nx),
+        })
     }
 
     /// The obstacles in lattice coordinates.
@@ -510,19 +575,41 @@ impl Scenario {
         self.obstacles
             .iter()
             .map(|o| match o {
-                ObstacleSpec::Circle { name, center, radius, interpolated } => Obstacle {
+                ObstacleSpec::Circle {
+                    name,
+                    center,
+                    radius,
+                    interpolated,
+                } => Obstacle {
                     name: name.clone(),
-                    shape: Shape::Circle { center: s(*center), radius: radius / units.dx },
+                    shape: Shape::Circle {
+                        center: s(*center),
+                        radius: radius / units.dx,
+                    },
                     interpolated: *interpolated,
                 },
-                ObstacleSpec::Rectangle { name, min, max, interpolated } => Obstacle {
+                ObstacleSpec::Rectangle {
+                    name,
+                    min,
+                    max,
+                    interpolated,
+                } => Obstacle {
                     name: name.clone(),
-                    shape: Shape::Rectangle { min: s(*min), max: s(*max) },
+                    shape: Shape::Rectangle {
+                        min: s(*min),
+                        max: s(*max),
+                    },
                     interpolated: *interpolated,
                 },
-                ObstacleSpec::Polygon { name, vertices, interpolated } => Obstacle {
+                ObstacleSpec::Polygon {
+                    name,
+                    vertices,
+                    interpolated,
+                } => Obstacle {
                     name: name.clone(),
-                    shape: Shape::Polygon { vertices: vertices.iter().map(|v| s(*v)).collect() },
+                    shape: Shape::Polygon {
+                        vertices: vertices.iter().map(|v| s(*v)).collect(),
+                    },
                     interpolated: *interpolated,
                 },
             })
@@ -547,13 +634,19 @@ impl Scenario {
         let obstacles = Obstacles::new(self.lattice_obstacles(&d.units));
         let solid = obstacles.mask(nx, ny);
         let edges = self.edges(&d.units, nx, ny)?;
-        let mut lattice = Lattice::<T>::new(nx, ny, edges, solid).map_err(|e| Error::config("boundaries", e))?;
+        let mut lattice =
+            Lattice::<T>::new(nx, ny, edges, solid).map_err(|e| Error::config("boundaries", e))?;
         let u0 = [
             d.units.velocity_to_lattice(self.initial.velocity[0]),
             d.units.velocity_to_lattice(self.initial.velocity[1]),
         ];
         lattice.fill(|_, _| (1.0, u0[0], u0[1]));
-        let collider = Collider::new(self.collision_model(d), d.tau, self.lbm.smagorinsky, d.force_lattice);
+        let collider = Collider::new(
+            self.collision_model(d),
+            d.tau,
+            self.lbm.smagorinsky,
+            d.force_lattice,
+        );
         Ok(Lbm::new(lattice, collider, obstacles, d.units))
     }
 

@@ -18,7 +18,10 @@ impl Scenario {
     pub fn from_file(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
         Self::from_toml(&text).map_err(|e| match e {
-            Error::Parse { message, .. } => Error::Parse { path: path.to_path_buf(), message },
+            Error::Parse { message, .. } => Error::Parse {
+                path: path.to_path_buf(),
+                message,
+            },
             other => other,
         })
     }

@@ -230,6 +230,12 @@ impl Default for ContactState {
 }
 
 impl ContactState {
+    /// Whether the grains touched at the last evaluation (δ > 0).
+    #[inline(always)]
+    pub fn touching(&self) -> bool {
+        self.delta > 0.0
+    }
+
     /// Apart, with overlap `delta` ≤ 0 remembered.
     #[inline(always)]
     fn apart(delta: f64) -> Self {
@@ -361,7 +367,7 @@ impl Law {
         }
         // Overlap at the start of the step. A contact that was apart has δ_k = δ_{k+1} − u_½h
         // (exact for a straight relative path), so the gap need not be stored.
-        let was = st.delta > 0.0;
+        let was = st.touching();
         let is = delta > 0.0;
         let d0 = if was {
             st.delta

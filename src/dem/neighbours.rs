@@ -284,12 +284,12 @@ impl Detector {
                     while o < old_g.len() && ((old_g[o] as u64) << 32 | old_w[o] as u64) < kp {
                         o += 1;
                     }
-                    let st =
-                        if o < old_g.len() && ((old_g[o] as u64) << 32 | old_w[o] as u64) == kp {
-                            old_s[o]
-                        } else {
-                            ContactState::default()
-                        };
+                    let st = if o < old_g.len() && ((old_g[o] as u64) << 32 | old_w[o] as u64) == kp
+                    {
+                        old_s[o]
+                    } else {
+                        ContactState::default()
+                    };
                     wl.grain.push(k as u32);
                     wl.wall.push(w as u32);
                     wl.state.push(st);

@@ -561,7 +561,7 @@ impl Dem {
                     let (ri, rj) = (g.radius[i], g.radius[j]);
                     let d2 = dx * dx + dy * dy;
                     let rs = ri + rj;
-                    if d2 >= rs * rs && !(state[k].delta > 0.0) {
+                    if d2 >= rs * rs && !state[k].touching() {
                         // Apart now and at the previous evaluation.
                         out[k] = [0.0; 4];
                         continue;
@@ -641,7 +641,7 @@ impl Dem {
                     let i = wg[o + k] as usize;
                     let (s, [nx, ny]) = walls[ww[o + k] as usize].distance([g.x[i], g.y[i]]);
                     let ri = g.radius[i];
-                    if s >= ri && !(state[k].delta > 0.0) {
+                    if s >= ri && !state[k].touching() {
                         out[k] = [0.0; 3];
                         continue;
                     }

@@ -80,10 +80,16 @@ impl Edges {
     /// Checks that periodic edges come in pairs and that no two Zou–He edges meet at a corner.
     /// Returns the name of the offending edge pair and the reason.
     pub fn check(&self) -> Result<(), (&'static str, String)> {
-        let pairs = [("left/right", &self.left, &self.right), ("bottom/top", &self.bottom, &self.top)];
+        let pairs = [
+            ("left/right", &self.left, &self.right),
+            ("bottom/top", &self.bottom, &self.top),
+        ];
         for (name, a, b) in pairs {
             if (*a == Edge::Periodic) != (*b == Edge::Periodic) {
-                return Err((name, "a periodic edge needs a periodic opposite edge".into()));
+                return Err((
+                    name,
+                    "a periodic edge needs a periodic opposite edge".into(),
+                ));
             }
         }
         for (x, xn) in [(&self.left, "left"), (&self.right, "right")] {
@@ -158,7 +164,8 @@ pub fn zou_he<T: Real>(f: &mut [T; Q], unknown: u16, node: &ZouHeNode) {
     }
     // Residuals of mass and tangential momentum, removed by δ_i = λ + μ t_i.
     let r_m = rho - g.iter().sum::<f64>();
-    let r_t = rho * (u[0] * tx as f64 + u[1] * ty as f64) - (0..Q).map(|i| g[i] * ct(i)).sum::<f64>();
+    let r_t =
+        rho * (u[0] * tx as f64 + u[1] * ty as f64) - (0..Q).map(|i| g[i] * ct(i)).sum::<f64>();
     let (mut k, mut st, mut stt) = (0.0, 0.0, 0.0);
     for i in (0..Q).filter(|&i| is_unknown(i)) {
         k += 1.0;
@@ -191,7 +198,14 @@ mod tests {
         f[2] -= 2e-3;
         let unknown = (1 << 1) | (1 << 5) | (1 << 8);
         let mut g = f;
-        zou_he(&mut g, unknown, &ZouHeNode { normal: [1, 0], value: ZouHe::Velocity([ux, uy]) });
+        zou_he(
+            &mut g,
+            unknown,
+            &ZouHeNode {
+                normal: [1, 0],
+                value: ZouHe::Velocity([ux, uy]),
+            },
+        );
         let rho = (f[0] + f[2] + f[4] + 2.0 * (f[3] + f[6] + f[7])) / (1.0 - ux);
         assert_relative_eq!(g[1], f[3] + 2.0 / 3.0 * rho * ux, max_relative = 1e-13);
         assert_relative_eq!(
@@ -217,7 +231,14 @@ mod tests {
         let mut f = equilibrium(0.99, 0.05, 0.0);
         f[2] += 1e-3;
         let unknown = (1 << 3) | (1 << 6) | (1 << 7);
-        zou_he(&mut f, unknown, &ZouHeNode { normal: [-1, 0], value: ZouHe::Pressure(1.0) });
+        zou_he(
+            &mut f,
+            unknown,
+            &ZouHeNode {
+                normal: [-1, 0],
+                value: ZouHe::Pressure(1.0),
+            },
+        );
         let (r, _, jy) = moments(&f);
         assert_relative_eq!(r, 1.0, max_relative = 1e-14);
         assert!(jy.abs() < 1e-15);
@@ -231,7 +252,14 @@ mod tests {
         let mut f = equilibrium(1.0, 0.02, 0.001);
         f[4] += 5e-4;
         let unknown = (1 << 1) | (1 << 8);
-        zou_he(&mut f, unknown, &ZouHeNode { normal: [1, 0], value: ZouHe::Velocity([ux, uy]) });
+        zou_he(
+            &mut f,
+            unknown,
+            &ZouHeNode {
+                normal: [1, 0],
+                value: ZouHe::Velocity([ux, uy]),
+            },
+        );
         let (r, jx, jy) = moments(&f);
         assert_relative_eq!(jx / r, ux, max_relative = 1e-12);
         assert!((jy / r - uy).abs() < 1e-14);

@@ -119,7 +119,8 @@ impl<T: Real> Collider<T> {
         if LES {
             let two = T::c(2.0);
             let pi = (pxx * pxx + pyy * pyy + two * pxy * pxy).sqrt();
-            let tau = T::c(0.5) * (self.tau_t + (self.tau_t * self.tau_t + self.les_k * pi / rho).sqrt());
+            let tau =
+                T::c(0.5) * (self.tau_t + (self.tau_t * self.tau_t + self.les_k * pi / rho).sqrt());
             T::one() / tau
         } else {
             self.omega
@@ -128,13 +129,21 @@ impl<T: Real> Collider<T> {
 
     #[inline(always)]
     fn bgk<const L: usize, const LES: bool>(&self, f: &mut [[T; L]; Q]) {
-        let (half, one, three, c45, c15, nine) =
-            (T::c(0.5), T::one(), T::c(3.0), T::c(4.5), T::c(1.5), T::c(9.0));
+        let (half, one, three, c45, c15, nine) = (
+            T::c(0.5),
+            T::one(),
+            T::c(3.0),
+            T::c(4.5),
+            T::c(1.5),
+            T::c(9.0),
+        );
         let third = T::c(1.0 / 3.0);
         let w = [T::c(W[0]), T::c(W[1]), T::c(W[5])];
         let (fx, fy) = (self.fx, self.fy);
         for l in 0..L {
-            let g: [T; Q] = [f[0][l], f[1][l], f[2][l], f[3][l], f[4][l], f[5][l], f[6][l], f[7][l], f[8][l]];
+            let g: [T; Q] = [
+                f[0][l], f[1][l], f[2][l], f[3][l], f[4][l], f[5][l], f[6][l], f[7][l], f[8][l],
+            ];
             let rho = g[0] + g[1] + g[2] + g[3] + g[4] + g[5] + g[6] + g[7] + g[8];
             let jx = g[1] - g[3] + g[5] - g[6] - g[7] + g[8];
             let jy = g[2] - g[4] + g[5] + g[6] - g[7] - g[8];
@@ -169,8 +178,14 @@ impl<T: Real> Collider<T> {
 
     #[inline(always)]
     fn mrt<const L: usize, const LES: bool>(&self, f: &mut [[T; L]; Q]) {
-        let (half, one, two, three, four, six) =
-            (T::c(0.5), T::one(), T::c(2.0), T::c(3.0), T::c(4.0), T::c(6.0));
+        let (half, one, two, three, four, six) = (
+            T::c(0.5),
+            T::one(),
+            T::c(2.0),
+            T::c(3.0),
+            T::c(4.0),
+            T::c(6.0),
+        );
         let [s_e, s_eps, s_q] = self.s;
         let (fx, fy) = (self.fx, self.fy);
         let (i9, i36, i6, i12, i4) = (
@@ -288,7 +303,12 @@ mod tests {
             rho * ux * uy,
         ];
         for r in 0..Q {
-            assert!((m[r] - expect[r]).abs() < 1e-14, "moment {r}: {} vs {}", m[r], expect[r]);
+            assert!(
+                (m[r] - expect[r]).abs() < 1e-14,
+                "moment {r}: {} vs {}",
+                m[r],
+                expect[r]
+            );
         }
     }
 
@@ -314,7 +334,12 @@ mod tests {
             ux * fy + uy * fx,
         ];
         for r in 0..Q {
-            assert!((m[r] - expect[r]).abs() < 1e-16, "moment {r}: {} vs {}", m[r], expect[r]);
+            assert!(
+                (m[r] - expect[r]).abs() < 1e-16,
+                "moment {r}: {} vs {}",
+                m[r],
+                expect[r]
+            );
         }
     }
 
@@ -330,7 +355,10 @@ mod tests {
     #[test]
     fn collision_conserves_mass_and_adds_the_force() {
         let force = [1e-4, -3e-4];
-        for model in [CollisionModel::Bgk, CollisionModel::Mrt(MrtRates::standard(0.8))] {
+        for model in [
+            CollisionModel::Bgk,
+            CollisionModel::Mrt(MrtRates::standard(0.8)),
+        ] {
             for les in [None, Some(0.1)] {
                 let f0 = perturbed();
                 let c = Collider::<f64>::new(model, 0.8, les, force);
@@ -350,7 +378,11 @@ mod tests {
     #[test]
     fn mrt_with_equal_rates_is_bgk() {
         let tau = 0.7;
-        let rates = MrtRates { s_e: 1.0 / tau, s_eps: 1.0 / tau, s_q: 1.0 / tau };
+        let rates = MrtRates {
+            s_e: 1.0 / tau,
+            s_eps: 1.0 / tau,
+            s_q: 1.0 / tau,
+        };
         let f0 = perturbed();
         let mut a: [[f64; 1]; Q] = std::array::from_fn(|i| [f0[i]]);
         let mut b = a;
@@ -365,7 +397,10 @@ mod tests {
     #[test]
     fn equilibrium_is_a_fixed_point() {
         let f0 = equilibrium(1.0, 0.02, 0.01);
-        for model in [CollisionModel::Bgk, CollisionModel::Mrt(MrtRates::standard(0.6))] {
+        for model in [
+            CollisionModel::Bgk,
+            CollisionModel::Mrt(MrtRates::standard(0.6)),
+        ] {
             let mut a: [[f64; 1]; Q] = std::array::from_fn(|i| [f0[i]]);
             Collider::<f64>::new(model, 0.6, Some(0.1), [0.0; 2]).collide(&mut a);
             for i in 0..Q {

@@ -77,7 +77,9 @@ impl<T: Real> Lattice<T> {
     /// are inconsistent, or a Zou–He profile has the wrong length.
     pub fn new(nx: usize, ny: usize, edges: Edges, solid: Vec<bool>) -> Result<Self, String> {
         assert_eq!(solid.len(), nx * ny, "solid mask size");
-        edges.check().map_err(|(name, why)| format!("edges {name}: {why}"))?;
+        edges
+            .check()
+            .map_err(|(name, why)| format!("edges {name}: {why}"))?;
         for (name, e, len) in [
             ("left", &edges.left, ny),
             ("right", &edges.right, ny),
@@ -86,12 +88,17 @@ impl<T: Real> Lattice<T> {
         ] {
             if let Edge::Velocity(p) = e {
                 if p.len() != len {
-                    return Err(format!("edge {name}: velocity profile has {} nodes, expected {len}", p.len()));
+                    return Err(format!(
+                        "edge {name}: velocity profile has {} nodes, expected {len}",
+                        p.len()
+                    ));
                 }
             }
         }
         if nx < 3 || ny < 3 {
-            return Err(format!("the lattice needs at least 3×3 cells, got {nx}×{ny}"));
+            return Err(format!(
+                "the lattice needs at least 3×3 cells, got {nx}×{ny}"
+            ));
         }
         let n = nx * ny;
         let mut lat = Lattice {
@@ -143,7 +150,9 @@ impl<T: Real> Lattice<T> {
         for y in 0..self.ny {
             for x in 0..self.nx {
                 let c = y * self.nx + x;
-                let feq = if self.solid[c] { [0.0; Q] } else {
+                let feq = if self.solid[c] {
+                    [0.0; Q]
+                } else {
                     let (r, u, v) = init(x, y);
                     equilibrium(r, u, v)
                 };
@@ -160,7 +169,11 @@ impl<T: Real> Lattice<T> {
         let n = self.len();
         self.even = true;
         for c in 0..n {
-            let p = if self.solid[c] { [0.0; Q] } else { pops(c % self.nx, c / self.nx) };
+            let p = if self.solid[c] {
+                [0.0; Q]
+            } else {
+                pops(c % self.nx, c / self.nx)
+            };
             for i in 0..Q {
                 self.f[i * n + c] = T::c(p[i]);
             }
@@ -191,7 +204,11 @@ impl<T: Real> Lattice<T> {
         match edge {
             None => {
                 let c = (ty * nx + tx) as usize;
-                if self.solid[c] { Neighbour::Bounce(0) } else { Neighbour::Fluid(c as u32) }
+                if self.solid[c] {
+                    Neighbour::Bounce(0)
+                } else {
+                    Neighbour::Fluid(c as u32)
+                }
             }
             Some(Edge::Wall { velocity }) => Neighbour::Bounce(self.wall_index(velocity)),
             Some(Edge::Periodic) => unreachable!("periodic coordinates were wrapped"),
@@ -246,8 +263,13 @@ impl<T: Real> Lattice<T> {
                 let c = y * nx + x;
                 let mut bulk = false;
                 if !self.solid[c] {
-                    let nb: [Neighbour; Q] =
-                        std::array::from_fn(|i| if i == 0 { Neighbour::Fluid(c as u32) } else { Neighbour::Open });
+                    let nb: [Neighbour; Q] = std::array::from_fn(|i| {
+                        if i == 0 {
+                            Neighbour::Fluid(c as u32)
+                        } else {
+                            Neighbour::Open
+                        }
+                    });
                     let mut nb = nb;
                     for i in 1..Q {
                         nb[i] = self.neighbour(x, y, CX[i], CY[i]);
@@ -259,7 +281,11 @@ impl<T: Real> Lattice<T> {
                         let zou_he = self.zou_he_node(x, y, &nb);
                         self.special_of[c] = self.specials.len() as u32;
                         self.rows[y].specials.push(self.specials.len() as u32);
-                        self.specials.push(Special { cell: c as u32, nb, zou_he });
+                        self.specials.push(Special {
+                            cell: c as u32,
+                            nb,
+                            zou_he,
+                        });
                     }
                 }
                 match (bulk, run_start) {
@@ -294,11 +320,25 @@ impl<T: Real> Lattice<T> {
                 // SAFETY: within a step each slot is read and written by exactly one node (see
                 // module docs); bulk nodes of row y touch slots of their own node (even) or of
                 // their 8 in-domain neighbours (odd), which no other node touches.
-                unsafe { bulk_run(base.0, n, nx, ny, y, x0 as usize, x1 as usize, even, collider) };
+                unsafe {
+                    bulk_run(
+                        base.0,
+                        n,
+                        nx,
+                        ny,
+                        y,
+                        x0 as usize,
+                        x1 as usize,
+                        even,
+                        collider,
+                    )
+                };
             }
             for &s in &plan.specials {
                 // SAFETY: as above; special nodes touch only their own link slots.
-                unsafe { special_node(base.0, n, &specials[s as usize], even, collider, wall_corr) };
+                unsafe {
+                    special_node(base.0, n, &specials[s as usize], even, collider, wall_corr)
+                };
             }
         });
         self.even = !even;
@@ -437,13 +477,21 @@ unsafe fn gather<T: Real>(
         // The population arriving along e_j comes from x − e_j, i.e. across link ī.
         match sp.nb[OPP[j]] {
             Neighbour::Fluid(k) => {
-                g[j] = if even { *f.add(j * n + c) } else { *f.add(OPP[j] * n + k as usize) };
+                g[j] = if even {
+                    *f.add(j * n + c)
+                } else {
+                    *f.add(OPP[j] * n + k as usize)
+                };
             }
             Neighbour::Bounce(w) => {
                 // f_j = f_ī* − 6 w_ī (e_ī·u_w): applied here for values written by an even step,
                 // at the write for those written by an odd step.
                 let v = *f.add(j * n + c);
-                g[j] = if even { v } else { v + wall_corr[w as usize][j] };
+                g[j] = if even {
+                    v
+                } else {
+                    v + wall_corr[w as usize][j]
+                };
             }
             Neighbour::Open => {
                 unknown |= 1 << j;

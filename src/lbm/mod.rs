@@ -16,7 +16,7 @@ pub mod real;
 pub mod solver;
 
 pub use boundary::{Edge, Edges};
-pub use collision::{CollisionModel, Collider, MrtRates};
+pub use collision::{Collider, CollisionModel, MrtRates};
 pub use lattice::Lattice;
 pub use obstacle::{Obstacle, Obstacles, Shape};
 pub use real::Real;

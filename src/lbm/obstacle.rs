@@ -79,7 +79,9 @@ impl Shape {
             Shape::Circle { center, .. } => *center,
             Shape::Polygon { vertices } => {
                 let m = vertices.len() as f64;
-                let s = vertices.iter().fold([0.0, 0.0], |a, v| [a[0] + v[0], a[1] + v[1]]);
+                let s = vertices
+                    .iter()
+                    .fold([0.0, 0.0], |a, v| [a[0] + v[0], a[1] + v[1]]);
                 [s[0] / m, s[1] / m]
             }
         }
@@ -95,7 +97,12 @@ impl Shape {
             ),
             Shape::Polygon { vertices } => vertices.iter().fold(
                 ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
-                |(lo, hi), v| ([lo[0].min(v[0]), lo[1].min(v[1])], [hi[0].max(v[0]), hi[1].max(v[1])]),
+                |(lo, hi), v| {
+                    (
+                        [lo[0].min(v[0]), lo[1].min(v[1])],
+                        [hi[0].max(v[0]), hi[1].max(v[1])],
+                    )
+                },
             ),
         }
     }
@@ -168,7 +175,10 @@ pub struct Obstacles {
 impl Obstacles {
     /// A set of obstacles, not yet linked to a lattice.
     pub fn new(list: Vec<Obstacle>) -> Self {
-        Obstacles { list, ..Default::default() }
+        Obstacles {
+            list,
+            ..Default::default()
+        }
     }
 
     /// Rasterise: the solid mask (`solid[y·nx + x]`) of the obstacles on an `nx × ny` lattice.
@@ -208,7 +218,9 @@ impl Obstacles {
             }
             let (x, y) = ((c as i64) % nx, (c as i64) / nx);
             for i in 1..Q {
-                let Some(b) = wrap(x + CX[i] as i64, y + CY[i] as i64) else { continue };
+                let Some(b) = wrap(x + CX[i] as i64, y + CY[i] as i64) else {
+                    continue;
+                };
                 if !lat.is_solid(b) {
                     continue;
                 }
@@ -220,7 +232,11 @@ impl Obstacles {
                 let owner = self.list.iter().position(|o| o.shape.contains(bc));
                 let Some(owner) = owner else { continue };
                 let ob = &self.list[owner];
-                let q = if ob.interpolated { ob.shape.crossing(a, e) } else { 0.5 };
+                let q = if ob.interpolated {
+                    ob.shape.crossing(a, e)
+                } else {
+                    0.5
+                };
                 let behind = wrap(x - CX[i] as i64, y - CY[i] as i64).filter(|&k| !lat.is_solid(k));
                 let cen = ob.shape.centre();
                 let arm = [a[0] + q * e[0] - cen[0], a[1] + q * e[1] - cen[1]];
@@ -289,9 +305,17 @@ mod tests {
     #[test]
     fn shapes_contain_their_centre_and_not_far_points() {
         let shapes = [
-            Shape::Rectangle { min: [1.0, 1.0], max: [3.0, 2.0] },
-            Shape::Circle { center: [2.0, 1.5], radius: 0.7 },
-            Shape::Polygon { vertices: vec![[1.0, 1.0], [3.0, 1.0], [2.0, 2.5]] },
+            Shape::Rectangle {
+                min: [1.0, 1.0],
+                max: [3.0, 2.0],
+            },
+            Shape::Circle {
+                center: [2.0, 1.5],
+                radius: 0.7,
+            },
+            Shape::Polygon {
+                vertices: vec![[1.0, 1.0], [3.0, 1.0], [2.0, 2.5]],
+            },
         ];
         for s in &shapes {
             assert!(s.contains(s.centre()), "{s:?}");
@@ -301,10 +325,15 @@ mod tests {
 
     #[test]
     fn circle_crossing_is_exact_and_bisection_agrees() {
-        let c = Shape::Circle { center: [0.0, 0.0], radius: 1.0 };
+        let c = Shape::Circle {
+            center: [0.0, 0.0],
+            radius: 1.0,
+        };
         // From (1.6, 0) towards −x: crosses at x = 1, q = 0.6.
         assert!((c.crossing([1.6, 0.0], [-1.0, 0.0]) - 0.6).abs() < 1e-12);
-        let p = Shape::Polygon { vertices: vec![[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]] };
+        let p = Shape::Polygon {
+            vertices: vec![[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]],
+        };
         assert!((p.crossing([1.25, 0.3], [-1.0, 0.0]) - 0.25).abs() < 1e-9);
     }
 }

@@ -75,9 +75,20 @@ pub struct Lbm<T> {
 
 impl<T: Real> Lbm<T> {
     /// Assemble a solver; links the obstacles to the lattice.
-    pub fn new(lattice: Lattice<T>, collider: Collider<T>, mut obstacles: Obstacles, units: Units) -> Self {
+    pub fn new(
+        lattice: Lattice<T>,
+        collider: Collider<T>,
+        mut obstacles: Obstacles,
+        units: Units,
+    ) -> Self {
         obstacles.link(&lattice);
-        Lbm { lattice, collider, obstacles, units, steps: 0 }
+        Lbm {
+            lattice,
+            collider,
+            obstacles,
+            units,
+            steps: 0,
+        }
     }
 
     /// One lattice step.
@@ -110,7 +121,13 @@ impl<T: Real> Lbm<T> {
         m.ny = self.lattice.ny;
         let vals: Vec<(f64, f64, f64)> = (0..n)
             .into_par_iter()
-            .map(|c| if self.lattice.is_solid(c) { (1.0, 0.0, 0.0) } else { self.cell(c) })
+            .map(|c| {
+                if self.lattice.is_solid(c) {
+                    (1.0, 0.0, 0.0)
+                } else {
+                    self.cell(c)
+                }
+            })
             .collect();
         m.rho = vals.iter().map(|v| v.0).collect();
         m.ux = vals.iter().map(|v| v.1).collect();
@@ -253,7 +270,11 @@ impl<T: Real> Scale for Lbm<T> {
     }
     fn snapshot(&self) -> LbmSnapshot<T> {
         let (populations, next_even) = self.lattice.state();
-        LbmSnapshot { populations, next_even, steps: self.steps }
+        LbmSnapshot {
+            populations,
+            next_even,
+            steps: self.steps,
+        }
     }
     fn restore(&mut self, s: LbmSnapshot<T>) {
         self.lattice.set_state(s.populations, s.next_even);

@@ -2,4 +2,6 @@
 use super::{Check, Fidelity};
 use crate::Result;
 /// Run the case.
-pub fn run(_f: Fidelity) -> Result<Vec<Check>> { Err(crate::Error::Other("les: not implemented yet".into())) }
+pub fn run(_f: Fidelity) -> Result<Vec<Check>> {
+    Err(crate::Error::Other("les: not implemented yet".into()))
+}

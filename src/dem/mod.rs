@@ -10,14 +10,18 @@
 //! * [`energy`]: the energy budget;
 //! * [`packing`]: reproducible packings (gravity deposition, hexagonal);
 //! * [`scale`]: the [`crate::scale::Scale`] implementation (sub-cycling `advance`);
-//! * [`validation`]: validation cases (restitution, incline, conservation, energy budget).
+//! * [`validation`]: validation cases (restitution, incline, conservation, energy budget);
+//! * [`scenario`]: the column-collapse scenario (TOML) and its checks;
+//! * [`run`]: the column-collapse runner (VTK series, time series, summary).
 
 pub mod contact;
 pub mod energy;
 pub mod grains;
 pub mod neighbours;
 pub mod packing;
+pub mod run;
 pub mod scale;
+pub mod scenario;
 pub mod solver;
 pub mod validation;
 pub mod walls;

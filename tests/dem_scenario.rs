@@ -101,9 +101,21 @@ fn bad_values_are_refused_with_the_field_named() {
     for (from, to, field) in [
         ("d_max = 6.0e-3", "d_max = 3.0e-3", "grains.d_max"),
         ("width = 0.04", "width = 0.01", "column.width"),
-        ("box_length = 0.16", "box_length = 0.03", "column.box_length"),
-        ("packing_estimate = 0.8", "packing_estimate = 0.95", "column.packing_estimate"),
-        ("restitution = 0.5", "restitution = 1.5", "grain_contact.restitution"),
+        (
+            "box_length = 0.16",
+            "box_length = 0.03",
+            "column.box_length",
+        ),
+        (
+            "packing_estimate = 0.8",
+            "packing_estimate = 0.95",
+            "column.packing_estimate",
+        ),
+        (
+            "restitution = 0.5",
+            "restitution = 1.5",
+            "grain_contact.restitution",
+        ),
         ("lambda = 0.1", "lambda = 0.0", "time.lambda"),
         ("density = 2500.0", "density = -1.0", "grains.density"),
     ] {

@@ -5,9 +5,10 @@
 //!
 //! | scale | module | method |
 //! |---|---|---|
+//! | grain | [`dem`] | discrete elements: disks, spring-dashpot contacts, friction, rolling resistance |
 //! | fluid | [`lbm`] | D2Q9 lattice Boltzmann, BGK / MRT, Smagorinsky LES |
 //!
-//! DEM grains and the GIMPM continuum are planned (see the issues); the fluid solver, the
+//! The GIMPM continuum is planned (see the issues); the fluid and grain solvers, the
 //! scenario format, the output contract and the validation harness are in place.
 //!
 //! All inputs are SI. [`units::Units`] converts between SI and lattice units, with the formula
@@ -17,6 +18,7 @@
 pub mod analysis;
 pub mod bench;
 pub mod config;
+pub mod dem;
 pub mod error;
 pub mod io;
 pub mod lbm;

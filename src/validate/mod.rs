@@ -286,7 +286,35 @@ pub const CASES: &[Case] = &[
         description: "seed Table 5.2: onset of shedding and Strouhal number",
         run: cylinder::run_shedding,
     },
+    Case {
+        name: "dem-restitution",
+        description: "head-on grain-grain and grain-wall impacts: e within 1 % for e = 0.3..0.95",
+        run: |f| checks_only(crate::dem::validation::restitution(f)),
+    },
+    Case {
+        name: "dem-incline",
+        description: "frictionless disk on a 45° segment: a/g = 0.7071, no rotation",
+        run: |f| checks_only(crate::dem::validation::incline(f)),
+    },
+    Case {
+        name: "dem-conservation",
+        description: "grain momentum to round-off; elastic-gas energy drift over 1e5 steps",
+        run: |f| checks_only(crate::dem::validation::conservation(f)),
+    },
+    Case {
+        name: "dem-energy",
+        description: "DEM energy budget of a settling run closes within 1 %",
+        run: |f| checks_only(crate::dem::validation::energy_budget(f)),
+    },
 ];
+
+/// A report of checks without figures.
+fn checks_only(checks: Result<Vec<Check>>) -> Result<Report> {
+    Ok(Report {
+        checks: checks?,
+        plots: Vec::new(),
+    })
+}
 
 /// Run a case by name.
 pub fn run(name: &str, fidelity: Fidelity) -> Result<Report> {

@@ -1,0 +1,126 @@
+//! Grains as a structure of arrays: one `Vec<f64>` per field, index `i` is grain `i`.
+//!
+//! Disks of radius R and mass m (per unit depth when the scenario is 2-D plane; any consistent
+//! mass unit otherwise) with moment of inertia J = ½ m R² (solid disk). The equations of motion
+//! are seed eq. 5.55–5.57: m a = F_c + F_f + m g − c v, J θ̈ = T_c + T_f.
+
+/// Disk grains, structure of arrays.
+#[derive(Clone, Debug, Default)]
+pub struct Grains {
+    /// Centre x (m).
+    pub x: Vec<f64>,
+    /// Centre y (m).
+    pub y: Vec<f64>,
+    /// Velocity x (m/s).
+    pub vx: Vec<f64>,
+    /// Velocity y (m/s).
+    pub vy: Vec<f64>,
+    /// Rotation angle θ (rad, counter-clockwise).
+    pub angle: Vec<f64>,
+    /// Angular velocity ω = θ̇ (rad/s, counter-clockwise).
+    pub omega: Vec<f64>,
+    /// Radius R (m).
+    pub radius: Vec<f64>,
+    /// Mass m.
+    pub mass: Vec<f64>,
+    /// Moment of inertia J = ½ m R².
+    pub inertia: Vec<f64>,
+    /// Total force x of the last force evaluation (contacts, gravity, external, damping).
+    pub fx: Vec<f64>,
+    /// Total force y of the last force evaluation.
+    pub fy: Vec<f64>,
+    /// Total torque of the last force evaluation.
+    pub torque: Vec<f64>,
+}
+
+impl Grains {
+    /// No grains.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Room for `n` grains without reallocation.
+    pub fn with_capacity(n: usize) -> Self {
+        let v = || Vec::with_capacity(n);
+        Grains {
+            x: v(),
+            y: v(),
+            vx: v(),
+            vy: v(),
+            angle: v(),
+            omega: v(),
+            radius: v(),
+            mass: v(),
+            inertia: v(),
+            fx: v(),
+            fy: v(),
+            torque: v(),
+        }
+    }
+
+    /// Number of grains.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// Whether there are no grains.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// Append a disk at rest with centre (x, y), radius `r` and mass `m`; J = ½ m r².
+    /// Returns its index.
+    pub fn push(&mut self, x: f64, y: f64, r: f64, m: f64) -> usize {
+        self.x.push(x);
+        self.y.push(y);
+        self.vx.push(0.0);
+        self.vy.push(0.0);
+        self.angle.push(0.0);
+        self.omega.push(0.0);
+        self.radius.push(r);
+        self.mass.push(m);
+        self.inertia.push(0.5 * m * r * r);
+        self.fx.push(0.0);
+        self.fy.push(0.0);
+        self.torque.push(0.0);
+        self.x.len() - 1
+    }
+
+    /// Append a disk of areal density `rho` (mass per unit area, so m = ρ π r²).
+    pub fn push_disk(&mut self, x: f64, y: f64, r: f64, rho: f64) -> usize {
+        self.push(x, y, r, rho * std::f64::consts::PI * r * r)
+    }
+
+    /// Smallest grain mass (∞ if empty).
+    pub fn min_mass(&self) -> f64 {
+        self.mass.iter().copied().fold(f64::INFINITY, f64::min)
+    }
+
+    /// Smallest moment of inertia (∞ if empty).
+    pub fn min_inertia(&self) -> f64 {
+        self.inertia.iter().copied().fold(f64::INFINITY, f64::min)
+    }
+
+    /// Largest radius (0 if empty).
+    pub fn max_radius(&self) -> f64 {
+        self.radius.iter().copied().fold(0.0, f64::max)
+    }
+
+    /// Total linear momentum Σ m v.
+    pub fn momentum(&self) -> [f64; 2] {
+        let mut p = [0.0; 2];
+        for i in 0..self.len() {
+            p[0] += self.mass[i] * self.vx[i];
+            p[1] += self.mass[i] * self.vy[i];
+        }
+        p
+    }
+
+    /// Total grain area Σ π R².
+    pub fn area(&self) -> f64 {
+        self.radius
+            .iter()
+            .map(|r| std::f64::consts::PI * r * r)
+            .sum()
+    }
+}

@@ -1,0 +1,33 @@
+//! Discrete element method for disks (seed eq. 5.55–5.61).
+//!
+//! * [`grains`]: the grains as a structure of arrays;
+//! * [`contact`]: the contact law (linear spring-dashpot normal force with the damping set by a
+//!   restitution coefficient, tangential spring with history and Coulomb cap, rolling
+//!   resistance) and the critical time step;
+//! * [`walls`]: half-planes and line segments;
+//! * [`neighbours`]: uniform-grid cell list and Verlet neighbour list with contact history;
+//! * [`solver`]: the system [`Dem`] and its velocity-Verlet step;
+//! * [`energy`]: the energy budget;
+//! * [`packing`]: reproducible packings (gravity deposition, hexagonal);
+//! * [`scale`]: the [`crate::scale::Scale`] implementation (sub-cycling `advance`);
+//! * [`validation`]: validation cases (restitution, incline, conservation, energy budget);
+//! * [`scenario`]: the column-collapse scenario (TOML) and its checks;
+//! * [`run`]: the column-collapse runner (VTK series, time series, summary).
+
+pub mod contact;
+pub mod energy;
+pub mod grains;
+pub mod neighbours;
+pub mod packing;
+pub mod run;
+pub mod scale;
+pub mod scenario;
+pub mod solver;
+pub mod validation;
+pub mod walls;
+
+pub use contact::{damping_ratio, restitution_of, ContactParams};
+pub use energy::Energy;
+pub use grains::Grains;
+pub use solver::{critical_step, Dem, DemParams, ExternalLoads};
+pub use walls::Wall;

@@ -1,0 +1,293 @@
+//! Runner of the DEM column collapse ([`DemScenario`]): deposit the column, remove the gate,
+//! integrate until the mass is at rest, and write
+//!
+//! * `series.pvd` with, per frame, `grains_NNNNNN.vtu` (part 0: points with radius, velocity,
+//!   angular velocity, contact count) and `contacts_NNNNNN.vtu` (part 1: a line cell per
+//!   touching grain–grain pair joining the two centres, with the normal and tangential force
+//!   magnitudes f_n, f_t — force chains in ParaView);
+//! * `timeseries.csv`: t, t/τ_c, run-out, front, height, energies, budget error;
+//! * `summary.json` ([`CollapseSummary`]).
+//!
+//! Definitions (REFERENCES, granular column collapse): τ_c = √(H_i/g) with H_i the deposited
+//! height; the *main mass* is the largest set of grains connected through touching contacts;
+//! the run-out L(t) is the largest x + R over the main mass (the thesis: the farthest grain
+//! still in contact with the main mass), measured from the left wall; the front is the largest
+//! x + R over all grains; the height H(t) is the largest y + R over the main mass. At rest:
+//! L_f, H_f, ΔL = (L_f − L_i)/L_i, H_f/L_i. The run stops when the kinetic energy has stayed
+//! below `rest_kinetic_fraction` × the initial potential energy above the floor for
+//! `rest_duration_tc` τ_c (and t ≥ 1 τ_c), or at `end_tc` τ_c.
+
+use std::path::Path;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::packing::deposit_column;
+use super::scenario::DemScenario;
+use super::solver::Dem;
+use super::walls::Wall;
+use crate::io::{write_json, write_vtu_points, CsvWriter, Field, PvdSeries};
+use crate::{Error, Result};
+
+/// What a collapse run reports (`summary.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct CollapseSummary {
+    /// Scenario name.
+    pub name: String,
+    /// Number of grains.
+    pub grains: usize,
+    /// Packing fraction of the deposited column (interior strip).
+    pub packing_fraction: f64,
+    /// Initial width L_i (m).
+    pub l_i: f64,
+    /// Deposited height H_i (m).
+    pub h_i: f64,
+    /// Actual aspect ratio a = H_i/L_i.
+    pub aspect_ratio: f64,
+    /// τ_c = √(H_i/g) (s).
+    pub tau_c: f64,
+    /// Final run-out L_f (m).
+    pub l_f: f64,
+    /// Final height H_f (m).
+    pub h_f: f64,
+    /// ΔL = (L_f − L_i)/L_i.
+    pub delta_l: f64,
+    /// H_f/L_i.
+    pub h_f_over_l_i: f64,
+    /// Time at which the mass came to rest (start of the rest interval), in τ_c.
+    pub stop_time_tc: f64,
+    /// Whether the run stopped at rest (false: it reached `end_tc`).
+    pub at_rest: bool,
+    /// Time step (s).
+    pub dt: f64,
+    /// Steps of the collapse.
+    pub steps: u64,
+    /// Wall time of the collapse (s), deposition excluded.
+    pub wall_time_s: f64,
+    /// Wall time of the deposition (s).
+    pub deposition_wall_time_s: f64,
+    /// Collapse throughput: grains × steps / wall time.
+    pub particle_steps_per_s: f64,
+    /// |E_total(end) − E_total(0)| / dissipated energy.
+    pub energy_budget_error: f64,
+}
+
+/// Main mass, run-out, front, height, and contacts per grain.
+struct Shape {
+    runout: f64,
+    front: f64,
+    height: f64,
+    contacts: Vec<f64>,
+}
+
+fn find(parent: &mut [u32], mut a: u32) -> u32 {
+    while parent[a as usize] != a {
+        let p = parent[a as usize];
+        parent[a as usize] = parent[p as usize];
+        a = p;
+    }
+    a
+}
+
+/// Measure the deposit shape (see the module doc) from the touching grain–grain pairs.
+fn shape(dem: &Dem) -> Shape {
+    let g = &dem.grains;
+    let n = g.len();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut contacts = vec![0.0; n];
+    let pl = dem.pairs();
+    for k in 0..pl.i.len() {
+        if pl.state[k].touching() {
+            let (i, j) = (pl.i[k], pl.j[k]);
+            contacts[i as usize] += 1.0;
+            contacts[j as usize] += 1.0;
+            let (a, b) = (find(&mut parent, i), find(&mut parent, j));
+            if a != b {
+                parent[a as usize] = b;
+            }
+        }
+    }
+    let wl = dem.wall_pairs();
+    for k in 0..wl.grain.len() {
+        if wl.state[k].touching() {
+            contacts[wl.grain[k] as usize] += 1.0;
+        }
+    }
+    let mut size = vec![0u32; n];
+    for i in 0..n {
+        let r = find(&mut parent, i as u32);
+        size[r as usize] += 1;
+    }
+    let main = (0..n).max_by_key(|&r| size[r]).unwrap_or(0) as u32;
+    let (mut runout, mut front, mut height) = (0.0f64, 0.0f64, 0.0f64);
+    for i in 0..n {
+        let right = g.x[i] + g.radius[i];
+        front = front.max(right);
+        if find(&mut parent, i as u32) == main {
+            runout = runout.max(right);
+            height = height.max(g.y[i] + g.radius[i]);
+        }
+    }
+    Shape {
+        runout,
+        front,
+        height,
+        contacts,
+    }
+}
+
+fn write_frame(dem: &Dem, s: &Shape, dir: &Path, k: usize, pvd: &mut PvdSeries) -> Result<()> {
+    let g = &dem.grains;
+    let n = g.len();
+    let points: Vec<[f64; 2]> = (0..n).map(|i| [g.x[i], g.y[i]]).collect();
+    let vel: Vec<[f64; 2]> = (0..n).map(|i| [g.vx[i], g.vy[i]]).collect();
+    let gname = format!("grains_{k:06}.vtu");
+    write_vtu_points(
+        &dir.join(&gname),
+        &points,
+        &[
+            Field::scalar("radius", &g.radius),
+            Field::vector("velocity", &vel),
+            Field::scalar("angular_velocity", &g.omega),
+            Field::scalar("contacts", &s.contacts),
+        ],
+        &[],
+        &[],
+    )?;
+    let pl = dem.pairs();
+    let (mut lines, mut f_n, mut f_t) = (Vec::new(), Vec::new(), Vec::new());
+    for p in 0..pl.i.len() {
+        let st = &pl.state[p];
+        if st.touching() {
+            lines.push([pl.i[p], pl.j[p]]);
+            f_n.push(st.f_n);
+            f_t.push(st.f_t);
+        }
+    }
+    let cname = format!("contacts_{k:06}.vtu");
+    // With no touching pair, write the points only (a valid vertex set).
+    let (cf_n, cf_t) = (
+        Field::scalar("normal_force", &f_n),
+        Field::scalar("tangential_force", &f_t),
+    );
+    let cells: &[Field] = if lines.is_empty() { &[] } else { &[cf_n, cf_t] };
+    write_vtu_points(&dir.join(&cname), &points, &[], &lines, cells)?;
+    pvd.add(dem.time(), 0, &gname)?;
+    pvd.add(dem.time(), 1, &cname)
+}
+
+/// Run the collapse described by `scenario`, writing into `out_dir` (created if missing).
+/// Returns the summary also written to `summary.json`.
+pub fn run_column_collapse(scenario: &DemScenario, out_dir: &Path) -> Result<CollapseSummary> {
+    let d = scenario.derive()?;
+    std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
+    let t0 = Instant::now();
+    let column = deposit_column(&d.column)?;
+    let deposition_wall_time_s = t0.elapsed().as_secs_f64();
+    let (l_i, h_i) = (scenario.column.width, column.height);
+    let gmag = scenario.gravity;
+    let tau_c = (h_i / gmag).sqrt();
+    let walls = vec![
+        Wall::floor(0.0),
+        Wall::left(0.0),
+        Wall::right(scenario.column.box_length),
+    ];
+    let mut dem = Dem::new(column.grains, walls, d.params.clone())?;
+    let e0 = dem.energy();
+    let ts = &scenario.time;
+    let dt = dem.dt();
+    let series_steps = ((ts.series_interval_tc * tau_c / dt).ceil() as u64).max(1);
+    let frame_every = ((ts.frame_interval_tc / ts.series_interval_tc).round() as u64).max(1);
+    let mut csv = CsvWriter::create(
+        &out_dir.join("timeseries.csv"),
+        &[
+            "t",
+            "t_over_tc",
+            "runout",
+            "front",
+            "height",
+            "kinetic",
+            "rotational",
+            "potential",
+            "elastic",
+            "dissipated_normal",
+            "dissipated_friction",
+            "dissipated_rolling",
+            "budget_error",
+        ],
+    )?;
+    let mut pvd = PvdSeries::new(out_dir);
+    let rest_limit = ts.rest_kinetic_fraction * e0.potential;
+    let (mut rest_since, mut at_rest) = (None::<f64>, false);
+    let (mut row, mut frame) = (0u64, 0usize);
+    let t_run = Instant::now();
+    let budget = |e: &super::Energy| (e.total() - e0.total()).abs() / e.dissipated().max(1e-300);
+    let mut last;
+    loop {
+        let e = dem.energy();
+        let s = shape(&dem);
+        let t = dem.time();
+        csv.row(&[
+            t,
+            t / tau_c,
+            s.runout,
+            s.front,
+            s.height,
+            e.kinetic,
+            e.rotational,
+            e.potential,
+            e.elastic(),
+            e.dissipated_normal,
+            e.dissipated_friction,
+            e.dissipated_rolling,
+            budget(&e),
+        ])?;
+        if row % frame_every == 0 {
+            write_frame(&dem, &s, out_dir, frame, &mut pvd)?;
+            frame += 1;
+        }
+        row += 1;
+        if e.kinetic_total() < rest_limit {
+            let since = *rest_since.get_or_insert(t);
+            if t >= tau_c && t - since >= ts.rest_duration_tc * tau_c {
+                at_rest = true;
+            }
+        } else {
+            rest_since = None;
+        }
+        last = (s, e);
+        if at_rest || t >= ts.end_tc * tau_c {
+            break;
+        }
+        dem.advance_with(series_steps as f64 * dt, None)?;
+    }
+    let wall_time_s = t_run.elapsed().as_secs_f64();
+    if (row - 1) % frame_every != 0 {
+        write_frame(&dem, &last.0, out_dir, frame, &mut pvd)?;
+    }
+    let (s, e) = last;
+    let steps = dem.step_count();
+    let summary = CollapseSummary {
+        name: scenario.name.clone(),
+        grains: dem.grains.len(),
+        packing_fraction: column.packing_fraction,
+        l_i,
+        h_i,
+        aspect_ratio: h_i / l_i,
+        tau_c,
+        l_f: s.runout,
+        h_f: s.height,
+        delta_l: (s.runout - l_i) / l_i,
+        h_f_over_l_i: s.height / l_i,
+        stop_time_tc: rest_since.unwrap_or(dem.time()) / tau_c,
+        at_rest,
+        dt,
+        steps,
+        wall_time_s,
+        deposition_wall_time_s,
+        particle_steps_per_s: dem.grains.len() as f64 * steps as f64 / wall_time_s.max(1e-9),
+        energy_budget_error: budget(&e),
+    };
+    write_json(&out_dir.join("summary.json"), &summary)?;
+    Ok(summary)
+}

@@ -174,23 +174,24 @@ impl<T: Real> Collider<T> {
             };
             let keep = one - omega;
             let base = one - c15 * (ux * ux + uy * uy);
-            // ω w_i ρ for the three weight classes.
+            // ω w_i ρ for the three weight classes, and 3× it for the odd part.
             let (r0, r1, r5) = (omega * w0 * rho, omega * w1 * rho, omega * w5 * rho);
+            let (t1, t5) = (three * r1, three * r5);
             f[0][l] = keep * g[0] + r0 * base;
-            // (i, ī, e_i·u, ω w ρ) for the four opposite pairs.
+            // (i, ī, e_i·u, ω w ρ, 3 ω w ρ) for the four opposite pairs; fused multiply–adds.
             macro_rules! pair {
-                ($i:literal, $o:literal, $cu:expr, $r:expr) => {{
+                ($i:literal, $o:literal, $cu:expr, $r:expr, $t:expr) => {{
                     let cu = $cu;
-                    let even = $r * (base + c45 * cu * cu);
-                    let odd = $r * three * cu;
-                    f[$i][l] = keep * g[$i] + (even + odd);
-                    f[$o][l] = keep * g[$o] + (even - odd);
+                    let even = $r * c45.mul_add(cu * cu, base);
+                    let odd = $t * cu;
+                    f[$i][l] = keep.mul_add(g[$i], even + odd);
+                    f[$o][l] = keep.mul_add(g[$o], even - odd);
                 }};
             }
-            pair!(1, 3, ux, r1);
-            pair!(2, 4, uy, r1);
-            pair!(5, 7, ux + uy, r5);
-            pair!(6, 8, uy - ux, r5);
+            pair!(1, 3, ux, r1, t1);
+            pair!(2, 4, uy, r1, t1);
+            pair!(5, 7, ux + uy, r5, t5);
+            pair!(6, 8, uy - ux, r5, t5);
             if FORCE {
                 // Guo: (1 − ω/2) w_i [3(e_i − u)·F + 9(e_i·u)(e_i·F)].
                 let fk = one - half * omega;

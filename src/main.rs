@@ -220,6 +220,15 @@ fn check_dem(path: &Path) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// Context for a run that failed part-way.
+fn stopped(path: &Path, out: &Path) -> String {
+    format!(
+        "run of {} stopped; frames written so far are in {}",
+        path.display(),
+        out.display()
+    )
+}
+
 fn run_dem(path: &Path, out: &Path) -> Result<ExitCode> {
     let s = DemScenario::from_file(path)?;
     let d = s.derive()?;
@@ -229,13 +238,7 @@ fn run_dem(path: &Path, out: &Path) -> Result<ExitCode> {
         d.grains,
         out.display()
     );
-    let r = granflow::dem::run::run_column_collapse(&s, out).with_context(|| {
-        format!(
-            "run of {} stopped; frames written so far are in {}",
-            path.display(),
-            out.display()
-        )
-    })?;
+    let r = granflow::dem::run::run_column_collapse(&s, out).with_context(|| stopped(path, out))?;
     println!(
         "done: a = {:.3}, L_f/L_i − 1 = {:.3}, H_f/L_i = {:.3}, stop at {:.2} τ_c ({}), {} grains, packing {:.3}",
         r.aspect_ratio,
@@ -287,13 +290,7 @@ fn run(path: &Path, out: &Path) -> Result<ExitCode> {
             }
         })
     }
-    .with_context(|| {
-        format!(
-            "run of {} stopped; frames written so far are in {}",
-            path.display(),
-            out.display()
-        )
-    })?;
+    .with_context(|| stopped(path, out))?;
     println!(
         "done: {} steps, {:.1} s simulated, {} frames, {:.1} s wall, {:.1} MLUPS, mass drift {:.2e}",
         summary.steps, summary.time, summary.frames, summary.wall_seconds, summary.mlups, summary.mass_drift

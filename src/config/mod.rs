@@ -16,21 +16,32 @@ use crate::{Error, Result};
 impl Scenario {
     /// Parse a scenario file.
     pub fn from_file(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        Self::from_toml(&text).map_err(|e| match e {
-            Error::Parse { message, .. } => Error::Parse {
-                path: path.to_path_buf(),
-                message,
-            },
-            other => other,
-        })
+        read_toml(path)
     }
 
     /// Parse scenario text.
     pub fn from_toml(text: &str) -> Result<Self> {
-        toml::from_str(text).map_err(|e| Error::Parse {
-            path: "<text>".into(),
-            message: e.to_string(),
-        })
+        parse_toml(text)
     }
+}
+
+/// Parse TOML text into a scenario type; the error carries the parser's message, which names
+/// the line and the key (unknown, missing or mistyped).
+pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T> {
+    toml::from_str(text).map_err(|e| Error::Parse {
+        path: "<text>".into(),
+        message: e.to_string(),
+    })
+}
+
+/// Read and parse a scenario file (see [`parse_toml`]); errors name the file.
+pub fn read_toml<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    parse_toml(&text).map_err(|e| match e {
+        Error::Parse { message, .. } => Error::Parse {
+            path: path.to_path_buf(),
+            message,
+        },
+        other => other,
+    })
 }

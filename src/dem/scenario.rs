@@ -187,22 +187,12 @@ fn positive(field: &str, v: f64) -> Result<()> {
 impl DemScenario {
     /// Parse scenario text.
     pub fn from_toml(text: &str) -> Result<Self> {
-        toml::from_str(text).map_err(|e| Error::Parse {
-            path: "<text>".into(),
-            message: e.to_string(),
-        })
+        crate::config::parse_toml(text)
     }
 
     /// Parse a scenario file.
     pub fn from_file(path: &std::path::Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        Self::from_toml(&text).map_err(|e| match e {
-            Error::Parse { message, .. } => Error::Parse {
-                path: path.to_path_buf(),
-                message,
-            },
-            other => other,
-        })
+        crate::config::read_toml(path)
     }
 
     /// Check every value and derive the solver set-up. Refuses, naming the field: non-positive

@@ -13,6 +13,21 @@
 //!
 //! All inputs are SI. [`units::Units`] converts between SI and lattice units, with the formula
 //! in each method's documentation.
+//!
+//! A fluid scenario from TOML, run for a few steps:
+//!
+//! ```
+//! use granflow::config::Scenario;
+//! let text = std::fs::read_to_string(
+//!     concat!(env!("CARGO_MANIFEST_DIR"), "/models/lbm/poiseuille.toml"),
+//! )?;
+//! let scenario = Scenario::from_toml(&text)?;
+//! let (mut fluid, derived) = scenario.build()?;
+//! assert!(derived.tau > 0.5 && derived.mach < 0.3);
+//! fluid.steps(100);
+//! fluid.check_stable(0.5)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 #![warn(missing_docs)]
 
 pub mod analysis;

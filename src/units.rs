@@ -12,6 +12,16 @@
 //! | pressure (gauge) | p = ρ₀ (Δx/Δt)² c_s² (ρ* − 1) |
 //! | force per unit depth | F = F* ρ₀ Δx³/Δt² |
 //! | time | t = n Δt |
+//!
+//! ```
+//! use granflow::units::Units;
+//! // Water (ν = 1e-6 m²/s) on a 1 mm lattice at τ = 0.8: Δt = (τ − ½)Δx²/(3ν) = 0.1 s.
+//! let u = Units::from_tau(1e-3, 0.8, 1e-6, 1000.0);
+//! assert!((u.dt - 0.1).abs() < 1e-12);
+//! // 1 cm/s in lattice units: u* = u Δt/Δx = 0.01 × 0.1 / 1e-3 = 1 (far too fast to run).
+//! assert!((u.velocity_to_lattice(0.01) - 1.0).abs() < 1e-12);
+//! assert!((u.tau(1e-6) - 0.8).abs() < 1e-12);
+//! ```
 
 use serde::Serialize;
 

@@ -1,6 +1,8 @@
-//! The cylinder validation cases at test fidelity: Schäfer–Turek 2D-1, the Sangani–Acrivos
-//! periodic array and the seed's vortex-shedding case. Every check of each case must pass, and
-//! every case returns at least one figure with data.
+//! The fluid validation cases at test fidelity (the same runs as `granflow validate <case>`):
+//! Poiseuille, Taylor–Green, conservation, LES channel, Ghia cavities, Schäfer–Turek 2D-1, the
+//! Sangani–Acrivos array and the seed's shedding case. Every check of each case must pass
+//! (references and tolerances are beside each check in `src/validate/`), and every case returns
+//! at least one figure with data.
 
 use granflow::validate::{self, Check, Fidelity};
 
@@ -38,6 +40,36 @@ fn run_case(name: &str) {
             );
         }
     }
+}
+
+#[test]
+fn poiseuille() {
+    run_case("poiseuille");
+}
+
+#[test]
+fn taylor_green() {
+    run_case("taylor-green");
+}
+
+#[test]
+fn conservation() {
+    run_case("conservation");
+}
+
+#[test]
+fn les_channel() {
+    run_case("les-channel");
+}
+
+#[test]
+fn cavity_re100() {
+    run_case("cavity-re100");
+}
+
+#[test]
+fn cavity_re1000() {
+    run_case("cavity-re1000");
 }
 
 #[test]

@@ -220,6 +220,29 @@ fn check_dem(path: &Path) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// Run `f` with a progress callback: an indicatif bar on a terminal, a plain line every 10 %
+/// otherwise (logs, CI).
+fn with_progress<R>(total: u64, unit: &str, f: impl FnOnce(&mut dyn FnMut(u64, u64)) -> R) -> R {
+    if std::io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(total);
+        let template =
+            format!("{{elapsed_precise}} [{{bar:40}}] {{pos}}/{{len}} {unit}, eta {{eta}}");
+        bar.set_style(indicatif::ProgressStyle::with_template(&template).expect("valid template"));
+        let r = f(&mut |i, _| bar.set_position(i));
+        bar.finish();
+        r
+    } else {
+        let mut last = 0;
+        f(&mut |i, n| {
+            let pct = i * 10 / n.max(1);
+            if pct > last {
+                last = pct;
+                eprintln!("{i}/{n} {unit} ({}%)", pct * 10);
+            }
+        })
+    }
+}
+
 /// Context for a run that failed part-way.
 fn stopped(path: &Path, out: &Path) -> String {
     format!(
@@ -238,7 +261,11 @@ fn run_dem(path: &Path, out: &Path) -> Result<ExitCode> {
         d.grains,
         out.display()
     );
-    let r = granflow::dem::run::run_column_collapse(&s, out).with_context(|| stopped(path, out))?;
+    let end = (1e3 * s.time.end_tc) as u64;
+    let r = with_progress(end, "milli-τ_c", |p| {
+        granflow::dem::run::run_column_collapse(&s, out, p)
+    })
+    .with_context(|| stopped(path, out))?;
     println!(
         "done: a = {:.3}, L_f/L_i − 1 = {:.3}, H_f/L_i = {:.3}, stop at {:.2} τ_c ({}), {} grains, packing {:.3}",
         r.aspect_ratio,
@@ -269,28 +296,8 @@ fn run(path: &Path, out: &Path) -> Result<ExitCode> {
         d.steps,
         out.display()
     );
-    let summary = if std::io::stderr().is_terminal() {
-        let bar = indicatif::ProgressBar::new(d.steps);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{elapsed_precise} [{bar:40}] {pos}/{len} steps, eta {eta}",
-            )
-            .expect("valid template"),
-        );
-        let r = granflow::run::run(&s, out, &mut |i, _| bar.set_position(i));
-        bar.finish();
-        r
-    } else {
-        let mut last = 0;
-        granflow::run::run(&s, out, &mut |i, n| {
-            let pct = i * 10 / n.max(1);
-            if pct > last {
-                last = pct;
-                eprintln!("step {i}/{n} ({}%)", pct * 10);
-            }
-        })
-    }
-    .with_context(|| stopped(path, out))?;
+    let summary = with_progress(d.steps, "steps", |p| granflow::run::run(&s, out, p))
+        .with_context(|| stopped(path, out))?;
     println!(
         "done: {} steps, {:.1} s simulated, {} frames, {:.1} s wall, {:.1} MLUPS, mass drift {:.2e}",
         summary.steps, summary.time, summary.frames, summary.wall_seconds, summary.mlups, summary.mass_drift

@@ -135,7 +135,7 @@ fn bad_values_are_refused_with_the_field_named() {
 fn tiny_collapse_runs_and_writes_outputs() {
     let s = DemScenario::from_toml(&tiny()).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let sum = run_column_collapse(&s, dir.path()).unwrap();
+    let sum = run_column_collapse(&s, dir.path(), &mut |_, _| {}).unwrap();
     println!("{}", serde_json::to_string_pretty(&sum).unwrap());
     assert!(sum.at_rest);
     assert!(sum.l_f > sum.l_i && sum.h_f < sum.h_i * 1.001);

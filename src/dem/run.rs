@@ -178,7 +178,11 @@ fn write_frame(dem: &Dem, s: &Shape, dir: &Path, k: usize, pvd: &mut PvdSeries) 
 
 /// Run the collapse described by `scenario`, writing into `out_dir` (created if missing).
 /// Returns the summary also written to `summary.json`.
-pub fn run_column_collapse(scenario: &DemScenario, out_dir: &Path) -> Result<CollapseSummary> {
+pub fn run_column_collapse(
+    scenario: &DemScenario,
+    out_dir: &Path,
+    progress: crate::run::Progress,
+) -> Result<CollapseSummary> {
     let d = scenario.derive()?;
     std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
     let t0 = Instant::now();
@@ -256,6 +260,8 @@ pub fn run_column_collapse(scenario: &DemScenario, out_dir: &Path) -> Result<Col
             rest_since = None;
         }
         last = (s, e);
+        // Progress in thousandths of τ_c, up to the end time.
+        progress((1e3 * t / tau_c) as u64, (1e3 * ts.end_tc) as u64);
         if at_rest || t >= ts.end_tc * tau_c {
             break;
         }

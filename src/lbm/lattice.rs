@@ -13,7 +13,8 @@
 //! (rayon) with no second array. Nodes whose 8 neighbours are plain fluid ("bulk") run through a
 //! vectorised loop over runs of a row; the rest ("special": next to a wall, a solid or an edge)
 //! go through a per-link path that applies half-way bounce-back and the Zou–He closure
-//! ([`super::boundary`]). Links into obstacles are listed with their wall distance q so that
+//! ([`super::boundary`]). An even step touches only a node's own slots, so in even steps every
+//! fluid node but the Zou–He ones takes the vectorised loop. Links into obstacles are listed with their wall distance q so that
 //! [`super::obstacle`] can apply interpolated bounce-back and momentum exchange after the step.
 
 use rayon::prelude::*;
@@ -56,6 +57,11 @@ struct RowPlan {
     runs: Vec<(u32, u32)>,
     /// Indices into `specials`.
     specials: Vec<u32>,
+    /// Even steps touch only a node's own slots, so there every fluid node but a Zou–He node
+    /// (which needs its closure) runs through the vector loop: these ranges …
+    even_runs: Vec<(u32, u32)>,
+    /// … and these Zou–He nodes (indices into `specials`).
+    even_specials: Vec<u32>,
 }
 
 /// The D2Q9 populations of a rectangular domain with its walls, obstacles and edges.
@@ -337,7 +343,35 @@ impl<T: Real> Lattice<T> {
             if let Some(s) = run_start {
                 self.rows[y].runs.push((s as u32, nx as u32));
             }
+            self.plan_even_row(y);
         }
+    }
+
+    /// Even-step work of row `y` (see [`RowPlan::even_runs`]).
+    fn plan_even_row(&mut self, y: usize) {
+        let nx = self.nx;
+        let (mut runs, mut zou_he) = (Vec::new(), Vec::new());
+        let mut run_start: Option<usize> = None;
+        for x in 0..=nx {
+            let local = x < nx && {
+                let c = y * nx + x;
+                let s = self.special_of[c];
+                if s != u32::MAX && self.specials[s as usize].zou_he.is_some() {
+                    zou_he.push(s);
+                }
+                !self.solid[c] && (s == u32::MAX || self.specials[s as usize].zou_he.is_none())
+            };
+            match (local, run_start) {
+                (true, None) => run_start = Some(x),
+                (false, Some(s)) => {
+                    runs.push((s as u32, x as u32));
+                    run_start = None;
+                }
+                _ => {}
+            }
+        }
+        self.rows[y].even_runs = runs;
+        self.rows[y].even_specials = zou_he;
     }
 
     /// True if the next step is even (populations in natural layout, A[x][i] = f_i(x)).
@@ -354,7 +388,12 @@ impl<T: Real> Lattice<T> {
         let specials = &self.specials;
         let wall_corr = &self.wall_corr;
         self.rows.par_iter().enumerate().for_each(|(y, plan)| {
-            for &(x0, x1) in &plan.runs {
+            let (runs, group_list) = if even {
+                (&plan.even_runs, &plan.even_specials)
+            } else {
+                (&plan.runs, &plan.specials)
+            };
+            for &(x0, x1) in runs {
                 // SAFETY: within a step each slot is read and written by exactly one node (see
                 // module docs); bulk nodes of row y touch slots of their own node (even) or of
                 // their 8 in-domain neighbours (odd), which no other node touches.
@@ -367,7 +406,7 @@ impl<T: Real> Lattice<T> {
                     }
                 };
             }
-            for group in plan.specials.chunks(LANES) {
+            for group in group_list.chunks(LANES) {
                 // SAFETY: as above; special nodes touch only their own link slots.
                 unsafe {
                     special_nodes(

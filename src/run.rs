@@ -107,15 +107,18 @@ pub fn run(scenario: &Scenario, out: &Path, progress: Progress) -> Result<Summar
             result = Err(e);
             break;
         }
-        let frame = s % derived.frame_every == 0 || s == total;
-        if s % derived.series_every == 0 || s == total {
+        let row = s % derived.series_every == 0 || s == total;
+        if row {
             state.row(fluid.as_ref(), &mut macro_)?;
             if s * 2 >= total {
                 lift.push(fluid.obstacle_loads().0.first().map_or(0.0, |f| f[1]));
             }
         }
-        if frame {
-            fluid.macroscopic(&mut macro_);
+        if s % derived.frame_every == 0 || s == total {
+            // A row just filled the fields; otherwise compute them for the frame.
+            if !row {
+                fluid.macroscopic(&mut macro_);
+            }
             state.write_frame(&macro_, s as f64 * derived.units.dt)?;
         }
         progress(s, total);

@@ -404,7 +404,7 @@ impl Scenario {
                 _ => {}
             }
         }
-        let edges = self.edges(&units, nx, ny)?;
+        let edges = self.edges(&units, nx, ny);
         edges
             .check()
             .map_err(|(f, why)| Error::config(format!("boundaries.{f}"), why))?;
@@ -538,7 +538,7 @@ impl Scenario {
     }
 
     /// The edge conditions in lattice units.
-    pub fn edges(&self, units: &Units, nx: usize, ny: usize) -> Result<Edges> {
+    pub fn edges(&self, units: &Units, nx: usize, ny: usize) -> Edges {
         let conv = |e: &EdgeSpec, len: usize| -> Edge {
             match e {
                 EdgeSpec::Periodic => Edge::Periodic,
@@ -576,12 +576,12 @@ impl Scenario {
             }
         };
         let b = &self.boundaries;
-        Ok(Edges {
+        Edges {
             left: conv(&b.left, ny),
             right: conv(&b.right, ny),
             bottom: conv(&b.bottom, nx),
             top: conv(&b.top, nx),
-        })
+        }
     }
 
     /// The obstacles in lattice coordinates.
@@ -648,7 +648,7 @@ impl Scenario {
         let [nx, ny] = d.cells;
         let obstacles = Obstacles::new(self.lattice_obstacles(&d.units));
         let solid = obstacles.mask(nx, ny);
-        let edges = self.edges(&d.units, nx, ny)?;
+        let edges = self.edges(&d.units, nx, ny);
         let mut lattice =
             Lattice::<T>::new(nx, ny, edges, solid).map_err(|e| Error::config("boundaries", e))?;
         let u0 = [

@@ -1,5 +1,6 @@
 //! Discrete element method for disks (seed eq. 5.55–5.61).
 //!
+//! * [`bench`]: the `granflow bench dem` case (LAMMPS `in.gran2d.lmp`);
 //! * [`grains`]: the grains as a structure of arrays;
 //! * [`contact`]: the contact law (linear spring-dashpot normal force with the damping set by a
 //!   restitution coefficient, tangential spring with history and Coulomb cap, rolling
@@ -8,12 +9,14 @@
 //! * [`neighbours`]: uniform-grid cell list and Verlet neighbour list with contact history;
 //! * [`solver`]: the system [`Dem`] and its velocity-Verlet step;
 //! * [`energy`]: the energy budget;
+//! * [`stress`]: per-grain Love–Weber stress tensor;
 //! * [`packing`]: reproducible packings (gravity deposition, hexagonal);
 //! * [`scale`]: the [`crate::scale::Scale`] implementation (sub-cycling `advance`);
 //! * [`validation`]: validation cases (restitution, incline, conservation, energy budget);
 //! * [`scenario`]: the column-collapse scenario (TOML) and its checks;
 //! * [`run`]: the column-collapse runner (VTK series, time series, summary).
 
+pub mod bench;
 pub mod contact;
 pub mod energy;
 pub mod grains;
@@ -23,6 +26,7 @@ pub mod run;
 pub mod scale;
 pub mod scenario;
 pub mod solver;
+pub mod stress;
 pub mod validation;
 pub mod walls;
 

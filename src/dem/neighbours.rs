@@ -100,6 +100,12 @@ impl Detector {
             })
     }
 
+    /// Positions at the last build and the squared displacement (skin/2)² beyond which the
+    /// list must be rebuilt (empty slices before the first build).
+    pub fn reference(&self) -> (&[f64], &[f64], f64) {
+        (&self.x_ref, &self.y_ref, 0.25 * self.skin * self.skin)
+    }
+
     /// Rebuild both lists from the current positions, carrying history over.
     pub fn build(&mut self, g: &Grains, walls: &[Wall], pairs: &mut PairList, wl: &mut WallList) {
         self.builds += 1;

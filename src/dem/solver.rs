@@ -31,7 +31,7 @@ use rayon::prelude::*;
 use super::contact::{self, ContactOut, ContactParams, Law, Motion};
 use super::energy::Energy;
 use super::grains::Grains;
-use super::neighbours::{Detector, PairList, WallList};
+use super::neighbours::{Detector, PairList, WallList, PAIR_ACTIVE, PAIR_TOUCHING};
 use super::walls::Wall;
 use crate::{Error, Result};
 
@@ -585,9 +585,10 @@ impl Dem {
             .state
             .par_chunks_mut(PAIR_CHUNK)
             .zip(self.pairs.out.par_chunks_mut(PAIR_CHUNK))
+            .zip(self.pairs.flags.par_chunks_mut(PAIR_CHUNK))
             .zip(self.events[..nch].par_iter_mut())
             .enumerate()
-            .map(|(c, ((state, out), ev))| {
+            .map(|(c, (((state, out), flags), ev))| {
                 ev.clear();
                 let o = c * PAIR_CHUNK;
                 let mut part = Part::default();
@@ -597,9 +598,9 @@ impl Dem {
                     let (ri, rj) = (g.radius[i], g.radius[j]);
                     let d2 = dx * dx + dy * dy;
                     let rs = ri + rj;
-                    if d2 >= rs * rs && !state[k].touching() {
+                    if d2 >= rs * rs && flags[k] & PAIR_TOUCHING == 0 {
                         // Apart now and at the previous evaluation.
-                        out[k] = [0.0; 4];
+                        flags[k] = 0;
                         continue;
                     }
                     let d = d2.sqrt();
@@ -627,6 +628,7 @@ impl Dem {
                         r_eff: ri * rj / rs,
                     };
                     let r = law.resolve(&motion, &mut state[k], dt_hist);
+                    flags[k] = PAIR_ACTIVE | if r.touching { PAIR_TOUCHING } else { 0 };
                     let [an, at, ar] = r.apply;
                     out[k] = [
                         -an * nx + at * tx,
@@ -760,16 +762,20 @@ impl Dem {
                     }
                     if i + 1 < pl.first.len() {
                         for p in pl.first[i] as usize..pl.first[i + 1] as usize {
-                            let q = &pl.out[p];
-                            f[0] += q[0];
-                            f[1] += q[1];
-                            t += q[2];
+                            if pl.flags[p] & PAIR_ACTIVE != 0 {
+                                let q = &pl.out[p];
+                                f[0] += q[0];
+                                f[1] += q[1];
+                                t += q[2];
+                            }
                         }
                         for &p in &pl.as_j[pl.j_start[i] as usize..pl.j_start[i + 1] as usize] {
-                            let q = &pl.out[p as usize];
-                            f[0] -= q[0];
-                            f[1] -= q[1];
-                            t += q[3];
+                            if pl.flags[p as usize] & PAIR_ACTIVE != 0 {
+                                let q = &pl.out[p as usize];
+                                f[0] -= q[0];
+                                f[1] -= q[1];
+                                t += q[3];
+                            }
                         }
                     }
                     if i + 1 < wl.first.len() {

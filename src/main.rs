@@ -285,12 +285,13 @@ fn run_dem(path: &Path, out: &Path) -> Result<ExitCode> {
     })
     .with_context(|| stopped(path, out))?;
     println!(
-        "done: a = {:.3}, L_f/L_i − 1 = {:.3}, H_f/L_i = {:.3}, stop at {:.2} τ_c ({}), {} grains, packing {:.3}",
+        "done: a = {:.3}, L_f/L_i − 1 = {:.3}, H_f/L_i = {:.3}, spreading stopped at {:.2} τ_c, {} at {:.2} τ_c, {} grains, packing {:.3}",
         r.aspect_ratio,
         r.delta_l,
         r.h_f_over_l_i,
         r.stop_time_tc,
         if r.at_rest { "at rest" } else { "end time reached" },
+        r.rest_time_tc,
         r.grains,
         r.packing_fraction
     );

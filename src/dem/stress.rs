@@ -1,22 +1,23 @@
-//! Per-grain stress tensor (Love–Weber): for grain i of area A_i = πR_i²,
+//! Per-grain stress tensor (Love–Weber): for grain i of volume V_i = πR_i² t (t the axial
+//! length of the disks; t = 1 when forces are per unit depth),
 //!
-//! σ_i = (1/A_i) Σ_c **f**_c ⊗ **l**_c,  σ_ab = (1/A_i) Σ_c f_a l_b,
+//! σ_i = (1/V_i) Σ_c **f**_c ⊗ **l**_c,  σ_ab = (1/V_i) Σ_c f_a l_b,
 //!
 //! summed over its contacts c (grain–grain and grain–wall), with **f**_c the contact force on
 //! grain i (−f_n **n** + f_t **t**, see [`crate::dem::contact`]) and **l**_c the branch vector
 //! from the centre to the contact point, taken in the middle of the overlap:
 //! **l**_c = (R_i − δ/2) **n** (**n** from i towards the partner). Tension is positive, so a
 //! grain squeezed along x has σ_xx < 0. The tensor is symmetric when the grain's contact torques
-//! balance (at rest); in motion the antisymmetric part is the contacts' net torque / A_i.
-//! Averaging A_i σ_i over a region and dividing by the region's area gives the usual
+//! balance (at rest); in motion the antisymmetric part is the contacts' net torque / V_i.
+//! Summing V_i σ_i over a region and dividing by the region's volume gives the usual
 //! homogenised stress of the packing (the voids contribute nothing).
 
 use super::solver::Dem;
 
-/// Love–Weber stress of every grain, row-major `[xx, xy, yx, yy]`, from the contact forces of
-/// the last force evaluation at the current positions. In plane 2-D the forces are per unit
-/// depth (N/m), so f·l/A is in Pa.
-pub fn grain_stress(dem: &Dem) -> Vec<[f64; 4]> {
+/// Love–Weber stress of every grain (Pa), row-major `[xx, xy, yx, yy]`, from the contact
+/// forces of the last force evaluation at the current positions; `thickness` is the disks'
+/// axial length t (1 if the forces are per unit depth).
+pub fn grain_stress(dem: &Dem, thickness: f64) -> Vec<[f64; 4]> {
     let g = &dem.grains;
     let mut s = vec![[0.0; 4]; g.len()];
     let mut add = |i: usize, f: [f64; 2], l: [f64; 2]| {
@@ -55,7 +56,7 @@ pub fn grain_stress(dem: &Dem) -> Vec<[f64; 4]> {
         add(i, f, [l * n[0], l * n[1]]);
     }
     for (t, r) in s.iter_mut().zip(&g.radius) {
-        let a = std::f64::consts::PI * r * r;
+        let a = std::f64::consts::PI * r * r * thickness;
         for v in t.iter_mut() {
             *v /= a;
         }
@@ -81,7 +82,7 @@ mod tests {
         let law = ContactParams::elastic(k);
         let mut dem = Dem::new(g, vec![], DemParams::new(law, law, [0.0, 0.0])).unwrap();
         dem.refresh_forces();
-        let s = grain_stress(&dem);
+        let s = grain_stress(&dem, 1.0);
         let want = -k * delta * (r - 0.5 * delta) / (std::f64::consts::PI * r * r);
         for t in &s {
             assert_relative_eq!(t[0], want, max_relative = 1e-12);
@@ -103,7 +104,7 @@ mod tests {
         )
         .unwrap();
         dem.refresh_forces();
-        let s = grain_stress(&dem);
+        let s = grain_stress(&dem, 1.0);
         let want = -k * delta * (r - 0.5 * delta) / (std::f64::consts::PI * r * r);
         assert_relative_eq!(s[0][3], want, max_relative = 1e-12);
         assert!(s[0][0].abs() + s[0][1].abs() + s[0][2].abs() < 1e-12 * want.abs());
@@ -154,7 +155,7 @@ mod tests {
             }
         }
         assert!(dem.energy().kinetic_total() < 1e-12 * scale * n);
-        let s = grain_stress(&dem);
+        let s = grain_stress(&dem, 1.0);
         let g = &dem.grains;
         let lhs: f64 = (0..g.len())
             .map(|i| std::f64::consts::PI * g.radius[i] * g.radius[i] * s[i][3])

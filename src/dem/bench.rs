@@ -83,7 +83,11 @@ pub fn system(n: usize, seed: u64) -> Result<Dem> {
     let mut p = DemParams::new(law, law, [0.0, -1.0]);
     p.dt = Some(1e-3);
     p.skin_fraction = 0.2 / 1.0; // skin = 0.2 (fraction of d_max = 1.0)
-    Dem::new(g, vec![Wall::floor(0.0), Wall::left(0.0), Wall::right(w)], p)
+    Dem::new(
+        g,
+        vec![Wall::floor(0.0), Wall::left(0.0), Wall::right(w)],
+        p,
+    )
 }
 
 /// Run the DEM benchmark on `threads` threads (0: rayon's default).

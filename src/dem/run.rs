@@ -353,7 +353,14 @@ pub fn run_column_collapse(
             budget(&e),
         ])?;
         if row % frame_every == 0 {
-            write_frame(&dem, &s, scenario.grains.thickness, out_dir, frame, &mut pvd)?;
+            write_frame(
+                &dem,
+                &s,
+                scenario.grains.thickness,
+                out_dir,
+                frame,
+                &mut pvd,
+            )?;
             frame += 1;
         }
         row += 1;
@@ -418,7 +425,14 @@ mod tests {
 
     #[test]
     fn spreading_ends_when_the_runout_settles() {
-        let h = [(0.0, 1.0), (1.0, 2.0), (2.0, 2.9), (3.0, 3.02), (4.0, 2.99), (5.0, 3.0)];
+        let h = [
+            (0.0, 1.0),
+            (1.0, 2.0),
+            (2.0, 2.9),
+            (3.0, 3.02),
+            (4.0, 2.99),
+            (5.0, 3.0),
+        ];
         assert_eq!(spreading_end(&h, 0.05), 3.0);
         assert_eq!(spreading_end(&h, 0.001), 5.0);
         assert_eq!(spreading_end(&h, 10.0), 0.0);

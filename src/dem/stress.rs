@@ -36,9 +36,16 @@ pub fn grain_stress(dem: &Dem, thickness: f64) -> Vec<[f64; 4]> {
         let (i, j) = (pl.i[p] as usize, pl.j[p] as usize);
         let (dx, dy) = (g.x[j] - g.x[i], g.y[j] - g.y[i]);
         let d = (dx * dx + dy * dy).sqrt();
-        let n = if d > 0.0 { [dx / d, dy / d] } else { [1.0, 0.0] };
+        let n = if d > 0.0 {
+            [dx / d, dy / d]
+        } else {
+            [1.0, 0.0]
+        };
         let half = 0.5 * (g.radius[i] + g.radius[j] - d);
-        let f = [-st.f_n * n[0] - st.f_t * n[1], -st.f_n * n[1] + st.f_t * n[0]];
+        let f = [
+            -st.f_n * n[0] - st.f_t * n[1],
+            -st.f_n * n[1] + st.f_t * n[0],
+        ];
         let (li, lj) = (g.radius[i] - half, g.radius[j] - half);
         add(i, f, [li * n[0], li * n[1]]);
         add(j, [-f[0], -f[1]], [-lj * n[0], -lj * n[1]]);
@@ -52,7 +59,10 @@ pub fn grain_stress(dem: &Dem, thickness: f64) -> Vec<[f64; 4]> {
         let i = wl.grain[p] as usize;
         let (dist, n) = dem.walls[wl.wall[p] as usize].distance([g.x[i], g.y[i]]);
         let l = g.radius[i] - 0.5 * (g.radius[i] - dist);
-        let f = [-st.f_n * n[0] - st.f_t * n[1], -st.f_n * n[1] + st.f_t * n[0]];
+        let f = [
+            -st.f_n * n[0] - st.f_t * n[1],
+            -st.f_n * n[1] + st.f_t * n[0],
+        ];
         add(i, f, [l * n[0], l * n[1]]);
     }
     for (t, r) in s.iter_mut().zip(&g.radius) {

@@ -522,8 +522,8 @@ impl Dem {
                 for k in 0..len {
                     let (dx, dy) = (x[k] - xr[k], y[k] - yr[k]);
                     let r2 = dx * dx + dy * dy;
-                    // NaN compares false: a non-finite grain forces a rebuild too.
-                    far |= !(r2 <= lim);
+                    // A non-finite grain forces a rebuild too.
+                    far |= r2 > lim || r2.is_nan();
                 }
                 far
             })

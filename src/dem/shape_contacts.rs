@@ -1,0 +1,243 @@
+//! Contacts found by the rapier detector (any pair with a polygon grain, and disk–polygon-wall
+//! pairs): contact history and forces, with the same contact law as the disk fast path
+//! ([`super::contact::Law::resolve`]) but the contact point as lever arm.
+//!
+//! For a contact point **p** with unit normal **n** (from i towards j), tangent
+//! **t** = (−n_y, n_x) and lever arms **r**_i = **p** − **x**_i, **r**_j = **p** − **x**_j, the
+//! velocity of i relative to j at the contact point is
+//! **v**_rel = **v**_i + ω_i × **r**_i − **v**_j − ω_j × **r**_j (ω × **r** = ω(−r_y, r_x)), split
+//! into u = **v**_rel·**n** and v_t = **v**_rel·**t**. The law gives (f_n, f_t, M); the force on i is
+//! **F**_i = −f_n **n** + f_t **t**, on j −**F**_i; the torques are T_i = **r**_i × **F**_i + M and
+//! T_j = −**r**_j × **F**_i − M (for disks, **r**_i = R_i**n** and **r**_j = −R_j**n** give back the
+//! cell-list torques R_i f_t + M and R_j f_t − M). m_eff = m_i m_j/(m_i + m_j) (m_i for a wall).
+//!
+//! Rolling resistance is off for any contact with a polygon grain (an angular grain resists
+//! rolling by its shape; the rolling spring models the shape of round grains): the law is used
+//! with k_r = 0 there, and as given for disk–polygon-wall contacts (R_eff = R_i).
+//!
+//! A face–face contact (e.g. a square lying on the floor) is two manifold points, each a
+//! spring-dashpot with its own history (key: the feature ids of the two sides), so the
+//! normal damping of such a contact is that of two parallel dashpots. History is carried from
+//! one step to the next by a linear merge of the sorted contact lists (no hashing).
+//! A point that disappears from rapier's manifold while touching (its feature pair changed)
+//! loses its history without an end-of-contact trapezoid.
+//!
+//! The loop is serial (polygon systems are small here); its cost is dominated by rapier.
+
+use super::contact::{ContactOut, ContactState, Law, Motion};
+use super::detect_rapier::{Contact, Coverage, RapierDetector};
+use super::grains::Grains;
+use super::walls::Wall;
+
+/// An onset/end difference **F**_{k+1} − **F**^end to add after the second half-kick:
+/// [F_x on i, F_y on i, torque on i, torque on j]; −F on j; `j == u32::MAX` for a wall.
+#[derive(Clone, Copy, Debug)]
+pub struct ShapeEvent {
+    /// Grain i.
+    pub i: u32,
+    /// Grain j, or `u32::MAX` for a wall.
+    pub j: u32,
+    /// Difference.
+    pub d: [f64; 4],
+}
+
+/// Sums of one evaluation (energies of the springs now, dissipation over the step).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ShapeSums {
+    /// Normal spring energy.
+    pub e_n: f64,
+    /// Tangential spring energy.
+    pub e_t: f64,
+    /// Rolling spring energy.
+    pub e_r: f64,
+    /// Dissipated by normal damping.
+    pub d_n: f64,
+    /// Dissipated by friction.
+    pub d_f: f64,
+    /// Dissipated by rolling resistance.
+    pub d_r: f64,
+    /// Touching contact points.
+    pub contacts: usize,
+}
+
+/// Contact points of the rapier-detected pairs with their history.
+#[derive(Clone, Debug)]
+pub struct ShapeContacts {
+    det: RapierDetector,
+    /// Contacts of the last evaluation, sorted by (i, j, key).
+    pub found: Vec<Contact>,
+    /// Contact state per entry of `found`.
+    pub state: Vec<ContactState>,
+    /// Force on i of each entry of `found` applied in the last second half-kick [F_x, F_y].
+    pub force: Vec<[f64; 2]>,
+    old: Vec<Contact>,
+    old_state: Vec<ContactState>,
+    events: Vec<ShapeEvent>,
+}
+
+impl ShapeContacts {
+    /// Contacts of the pairs the cell list does not handle, with points up to `prediction`
+    /// apart reported (the Verlet skin).
+    pub fn new(prediction: f64) -> Self {
+        ShapeContacts {
+            det: RapierDetector::new(Coverage::Complement, prediction),
+            found: Vec::new(),
+            state: Vec::new(),
+            force: Vec::new(),
+            old: Vec::new(),
+            old_state: Vec::new(),
+            events: Vec::new(),
+        }
+    }
+
+    /// Detect, carry history over, resolve every contact over a step `h` (0: evaluate only)
+    /// and add the forces to `g.fx`, `g.fy`, `g.torque`. `vp` are the predictor velocities
+    /// (x, y, ω) of the solver.
+    #[allow(clippy::too_many_arguments)]
+    pub fn evaluate(
+        &mut self,
+        g: &mut Grains,
+        walls: &[Wall],
+        vp: (&[f64], &[f64], &[f64]),
+        grain_law: &Law,
+        wall_law: &Law,
+        h: f64,
+    ) -> ShapeSums {
+        std::mem::swap(&mut self.old, &mut self.found);
+        std::mem::swap(&mut self.old_state, &mut self.state);
+        self.det.detect(g, walls, &mut self.found);
+        // History: both lists sorted by (i, j, key).
+        self.state.clear();
+        let mut o = 0;
+        for c in &self.found {
+            let k = c.order();
+            while o < self.old.len() && self.old[o].order() < k {
+                o += 1;
+            }
+            self.state
+                .push(if o < self.old.len() && self.old[o].order() == k {
+                    self.old_state[o]
+                } else {
+                    ContactState::default()
+                });
+        }
+        self.force.clear();
+        self.events.clear();
+        let (vxp, vyp, wp) = vp;
+        let mut sums = ShapeSums::default();
+        for (c, st) in self.found.iter().zip(self.state.iter_mut()) {
+            let i = c.i as usize;
+            let wall = c.wall();
+            let [nx, ny] = c.normal;
+            let (tx, ty) = (-ny, nx);
+            let ri = [c.point[0] - g.x[i], c.point[1] - g.y[i]];
+            // Velocities of the contact point on i minus on j: [current, predictor].
+            let mut vr = [
+                [g.vx[i] - g.omega[i] * ri[1], g.vy[i] + g.omega[i] * ri[0]],
+                [vxp[i] - wp[i] * ri[1], vyp[i] + wp[i] * ri[0]],
+            ];
+            let mut w = [g.omega[i], wp[i]];
+            let (law, m_eff, r_eff, rj);
+            if let Some(_w) = wall {
+                law = if g.is_disk(i) {
+                    *wall_law
+                } else {
+                    Law { k_r: 0.0, ..*wall_law }
+                };
+                m_eff = g.mass[i];
+                r_eff = g.radius[i];
+                rj = [0.0; 2];
+            } else {
+                let j = c.j as usize;
+                let r = [c.point[0] - g.x[j], c.point[1] - g.y[j]];
+                vr[0][0] -= g.vx[j] - g.omega[j] * r[1];
+                vr[0][1] -= g.vy[j] + g.omega[j] * r[0];
+                vr[1][0] -= vxp[j] - wp[j] * r[1];
+                vr[1][1] -= vyp[j] + wp[j] * r[0];
+                w = [w[0] - g.omega[j], w[1] - wp[j]];
+                law = if g.is_disk(i) && g.is_disk(j) {
+                    *grain_law
+                } else {
+                    Law { k_r: 0.0, ..*grain_law }
+                };
+                let (mi, mj) = (g.mass[i], g.mass[j]);
+                m_eff = mi * mj / (mi + mj);
+                r_eff = g.radius[i] * g.radius[j] / (g.radius[i] + g.radius[j]);
+                rj = r;
+            }
+            let motion = Motion {
+                delta: c.delta,
+                u: [
+                    vr[0][0] * nx + vr[0][1] * ny,
+                    vr[1][0] * nx + vr[1][1] * ny,
+                ],
+                v_t: [
+                    vr[0][0] * tx + vr[0][1] * ty,
+                    vr[1][0] * tx + vr[1][1] * ty,
+                ],
+                w,
+                m_eff,
+                r_eff,
+            };
+            let r: ContactOut = law.resolve(&motion, st, h);
+            let cross = |a: [f64; 2], f: [f64; 2]| a[0] * f[1] - a[1] * f[0];
+            let [an, at, ar] = r.apply;
+            let f = [-an * nx + at * tx, -an * ny + at * ty];
+            self.force.push(f);
+            g.fx[i] += f[0];
+            g.fy[i] += f[1];
+            g.torque[i] += cross(ri, f) + ar;
+            let j = if wall.is_some() { u32::MAX } else { c.j };
+            if j != u32::MAX {
+                let j = j as usize;
+                g.fx[j] -= f[0];
+                g.fy[j] -= f[1];
+                g.torque[j] += -cross(rj, f) - ar;
+            }
+            if r.event {
+                let (dn, dt, dm) = (st.f_n - an, st.f_t - at, st.m_r - ar);
+                let d = [-dn * nx + dt * tx, -dn * ny + dt * ty];
+                self.events.push(ShapeEvent {
+                    i: c.i,
+                    j,
+                    d: [d[0], d[1], cross(ri, d) + dm, -cross(rj, d) - dm],
+                });
+            }
+            sums.e_n += r.e_normal;
+            sums.e_t += r.e_tangential;
+            sums.e_r += r.e_rolling;
+            sums.d_n += r.d_normal;
+            sums.d_f += r.d_friction;
+            sums.d_r += r.d_rolling;
+            sums.contacts += usize::from(r.touching);
+        }
+        sums
+    }
+
+    /// Turn the forces of onset/end steps from **F**^end into **F**_{k+1} (after the kick).
+    pub fn apply_events(&self, g: &mut Grains) {
+        for ev in &self.events {
+            let (i, d) = (ev.i as usize, ev.d);
+            g.fx[i] += d[0];
+            g.fy[i] += d[1];
+            g.torque[i] += d[2];
+            if ev.j != u32::MAX {
+                let j = ev.j as usize;
+                g.fx[j] -= d[0];
+                g.fy[j] -= d[1];
+                g.torque[j] += d[3];
+            }
+        }
+    }
+
+    /// Total normal force on grain `i` from its contacts with wall `w` at the last evaluation
+    /// (Σ f_n of the touching points), for tests and output.
+    pub fn wall_normal_force(&self, i: usize, w: usize) -> f64 {
+        self.found
+            .iter()
+            .zip(&self.state)
+            .filter(|(c, _)| c.i as usize == i && c.wall() == Some(w))
+            .map(|(_, s)| s.f_n)
+            .sum()
+    }
+}

@@ -70,20 +70,19 @@ fn rapier_and_cell_list_agree_on_disks() {
         det.detect(&g, &walls, &mut rp);
         // One point per disk pair.
         assert!(rp.windows(2).all(|w| (w[0].i, w[0].j) != (w[1].i, w[1].j)));
-        let find = |l: &[Contact], c: &Contact| {
-            l.iter().find(|d| (d.i, d.j) == (c.i, c.j)).copied()
-        };
+        let find =
+            |l: &[Contact], c: &Contact| l.iter().find(|d| (d.i, d.j) == (c.i, c.j)).copied();
         let (mut n_gg, mut n_gw, mut worst_d, mut worst_n) = (0, 0, 0.0f64, 0.0f64);
         for (a, b, name) in [(&cl, &rp, "rapier"), (&rp, &cl, "cell list")] {
             for c in a.iter().filter(|c| c.delta > 0.0) {
                 let d = find(b, c)
                     .unwrap_or_else(|| panic!("seed {seed}: {name} misses contact {c:?}"));
                 let i = c.i as usize;
-                let scale = g.radius[i]
-                    + c.wall().map_or_else(|| g.radius[c.j as usize], |_| 0.0);
+                let scale = g.radius[i] + c.wall().map_or_else(|| g.radius[c.j as usize], |_| 0.0);
                 let ed = (c.delta - d.delta).abs() / scale;
-                let en = ((c.normal[0] - d.normal[0]).powi(2) + (c.normal[1] - d.normal[1]).powi(2))
-                    .sqrt();
+                let en = ((c.normal[0] - d.normal[0]).powi(2)
+                    + (c.normal[1] - d.normal[1]).powi(2))
+                .sqrt();
                 assert!(ed <= 1e-12 && en <= 1e-12, "seed {seed}: {c:?} vs {d:?}");
                 worst_d = worst_d.max(ed);
                 worst_n = worst_n.max(en);
@@ -102,7 +101,10 @@ fn rapier_and_cell_list_agree_on_disks() {
             n_gw / 2
         );
         // Not vacuous: many contacts of both kinds, every wall touched.
-        assert!(n_gg / 2 > 300 && n_gw / 2 > 20, "seed {seed}: {n_gg} {n_gw}");
+        assert!(
+            n_gg / 2 > 300 && n_gw / 2 > 20,
+            "seed {seed}: {n_gg} {n_gw}"
+        );
         for w in 0..walls.len() {
             assert!(
                 cl.iter().any(|c| c.delta > 0.0 && c.wall() == Some(w)),
@@ -120,9 +122,15 @@ fn detector_picked_per_pair_type() {
     let mut g = random_packing(7, 200);
     let sq = g
         .polygons
-        .add(&Polygons::regular(4, 0.5, 0.25 * std::f64::consts::PI), "sq")
+        .add(
+            &Polygons::regular(4, 0.5, 0.25 * std::f64::consts::PI),
+            "sq",
+        )
         .unwrap();
-    let tri = g.polygons.add(&Polygons::regular(3, 0.6, 0.1), "tri").unwrap();
+    let tri = g
+        .polygons
+        .add(&Polygons::regular(3, 0.6, 0.1), "tri")
+        .unwrap();
     for k in 0..g.len() {
         if k % 3 == 1 {
             g.shape[k] = if k % 2 == 0 { sq } else { tri };
@@ -233,7 +241,11 @@ fn square_on_frictional_incline() {
                 t2 - t1,
                 dem.grains.angle[0]
             );
-            assert!(v2.abs() < 1e-6 && (x2 - x1).abs() < 1e-6, "v = {v2}, dx = {}", x2 - x1);
+            assert!(
+                v2.abs() < 1e-6 && (x2 - x1).abs() < 1e-6,
+                "v = {v2}, dx = {}",
+                x2 - x1
+            );
         } else {
             let want = th.sin() - mu * th.cos();
             println!(
@@ -293,7 +305,75 @@ fn polygon_collision_conserves_momentum() {
         dem.grains.omega[a], dem.grains.omega[b]
     );
     assert!(touched > 10 && dem.contact_count() == 0);
-    assert!(dem.grains.omega[a].abs() > 1e-3, "off-centre impact must spin the square");
+    assert!(
+        dem.grains.omega[a].abs() > 1e-3,
+        "off-centre impact must spin the square"
+    );
     assert!(worst_p < 1e-13, "{worst_p}");
     assert!(worst_l < 1e-6, "{worst_l}");
+}
+
+/// Detection cost per step for 20 000 disks (the `in.gran2d.lmp` block: hexagonal, d uniform in
+/// [0.8, 1.0], spacing 0.97 so some touch), rapier's collision pipeline (all pairs) against the
+/// cell list. Indicative only (shared machine): run with
+/// `cargo test --release --test dem_rapier detection_timing -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn detection_timing() {
+    use granflow::dem::neighbours::{Detector, PairList, WallList};
+    use granflow::dem::packing::{hex_block, SizeDistribution};
+    use std::time::Instant;
+    let mut g = hex_block(
+        0.5,
+        0.5,
+        200,
+        100,
+        0.97,
+        [0.8, 1.0],
+        SizeDistribution::Uniform,
+        1.0,
+        3,
+    );
+    let walls = vec![Wall::floor(0.0), Wall::left(0.0), Wall::right(200.0)];
+    let skin = 0.2;
+    let mut rng = SplitMix64::new(9);
+    let mut jiggle = |g: &mut Grains| {
+        for i in 0..g.len() {
+            g.x[i] += 1e-3 * (rng.uniform() - 0.5);
+            g.y[i] += 1e-3 * (rng.uniform() - 0.5);
+        }
+    };
+    let steps = 20;
+    let mut det = RapierDetector::new(Coverage::All, skin);
+    let mut out = Vec::new();
+    let t = Instant::now();
+    det.detect(&g, &walls, &mut out);
+    let first = t.elapsed().as_secs_f64();
+    let mut t_r = 0.0;
+    for _ in 0..steps {
+        jiggle(&mut g);
+        let t = Instant::now();
+        det.detect(&g, &walls, &mut out);
+        t_r += t.elapsed().as_secs_f64();
+    }
+    let touching = out.iter().filter(|c| c.delta > 0.0).count();
+    let mut cl = Detector::new(skin);
+    let (mut pl, mut wl) = (PairList::default(), WallList::default());
+    cl.build(&g, &walls, &mut pl, &mut wl);
+    let mut t_c = 0.0;
+    for _ in 0..steps {
+        jiggle(&mut g);
+        let t = Instant::now();
+        cl.build(&g, &walls, &mut pl, &mut wl);
+        t_c += t.elapsed().as_secs_f64();
+    }
+    println!(
+        "{} disks, {touching} touching points: rapier2d-f64 collision pipeline {:.2} ms/step \
+         (first build {:.1} ms), cell list full rebuild {:.2} ms/step, {} threads",
+        g.len(),
+        1e3 * t_r / steps as f64,
+        1e3 * first,
+        1e3 * t_c / steps as f64,
+        rayon::current_num_threads()
+    );
 }

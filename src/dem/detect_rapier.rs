@@ -32,11 +32,11 @@
 //! narrow phase.
 
 use rapier2d_f64::geometry::{
-    BroadPhaseBvh, ColliderBuilder, ColliderHandle, ColliderSet, Group, InteractionGroups,
-    InteractionTestMode, NarrowPhase, SharedShape,
+    ActiveCollisionTypes, BroadPhaseBvh, ColliderBuilder, ColliderHandle, ColliderSet, Group,
+    InteractionGroups, InteractionTestMode, NarrowPhase, SharedShape,
 };
 use rapier2d_f64::math::{Pose, Vector};
-use rapier2d_f64::pipeline::{ActiveCollisionTypes, CollisionPipeline};
+use rapier2d_f64::pipeline::CollisionPipeline;
 use rapier2d_f64::prelude::{IslandManager, RigidBodySet};
 
 use super::grains::Grains;
@@ -257,7 +257,10 @@ impl RapierDetector {
             if manifolds.is_empty() {
                 continue;
             }
-            let (c1, c2) = (&self.colliders[pair.collider1], &self.colliders[pair.collider2]);
+            let (c1, c2) = (
+                &self.colliders[pair.collider1],
+                &self.colliders[pair.collider2],
+            );
             let (u1, u2) = (c1.user_data as u32, c2.user_data as u32);
             // Store (grain, grain) with i < j, or (grain, wall).
             let swap = (u1 & WALL_BIT != 0) || (u2 & WALL_BIT == 0 && u1 > u2);
@@ -267,7 +270,10 @@ impl RapierDetector {
                 let n = p1.rotation * m.local_n1;
                 let n = if swap { -n } else { n };
                 for pt in &m.points {
-                    let (a, b) = (p1.transform_point(pt.local_p1), p2.transform_point(pt.local_p2));
+                    let (a, b) = (
+                        p1.transform_point(pt.local_p1),
+                        p2.transform_point(pt.local_p2),
+                    );
                     let p = 0.5 * (a + b);
                     let (f1, f2) = (u64::from(pt.fid1.0), u64::from(pt.fid2.0));
                     out.push(Contact {

@@ -61,7 +61,7 @@ impl Grains {
             fx: v(),
             fy: v(),
             torque: v(),
-            shape: v(),
+            shape: Vec::with_capacity(n),
             polygons: Polygons::default(),
         }
     }

@@ -41,7 +41,8 @@ pub fn polygon_props(v: &[[f64; 2]]) -> PolygonProps {
         a2 += c;
         cx += (p[0] + q[0]) * c;
         cy += (p[1] + q[1]) * c;
-        j += c * (p[0] * p[0] + p[1] * p[1] + p[0] * q[0] + p[1] * q[1] + q[0] * q[0] + q[1] * q[1]);
+        j +=
+            c * (p[0] * p[0] + p[1] * p[1] + p[0] * q[0] + p[1] * q[1] + q[0] * q[0] + q[1] * q[1]);
     }
     let area = 0.5 * a2;
     let centroid = [cx / (3.0 * a2), cy / (3.0 * a2)];
@@ -168,7 +169,15 @@ mod tests {
         let mut t = Polygons::default();
         // Off-centre and clockwise: the table centres and re-orders it.
         let s = t
-            .add(&[[1.0, 2.0], [1.0, 2.0 + a], [1.0 + a, 2.0 + a], [1.0 + a, 2.0]], "sq")
+            .add(
+                &[
+                    [1.0, 2.0],
+                    [1.0, 2.0 + a],
+                    [1.0 + a, 2.0 + a],
+                    [1.0 + a, 2.0],
+                ],
+                "sq",
+            )
             .unwrap() as usize;
         let m = t.area[s];
         assert!((m - a * a).abs() < 1e-15);
@@ -198,7 +207,10 @@ mod tests {
     fn refuses_non_convex() {
         let mut t = Polygons::default();
         let e = t
-            .add(&[[0.0, 0.0], [2.0, 0.0], [1.0, 0.2], [2.0, 2.0], [0.0, 2.0]], "dem.shape")
+            .add(
+                &[[0.0, 0.0], [2.0, 0.0], [1.0, 0.2], [2.0, 2.0], [0.0, 2.0]],
+                "dem.shape",
+            )
             .unwrap_err();
         assert!(e.to_string().contains("dem.shape"), "{e}");
         assert!(t.add(&[[0.0, 0.0], [1.0, 0.0]], "x").is_err());

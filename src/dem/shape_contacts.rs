@@ -142,7 +142,10 @@ impl ShapeContacts {
                 law = if g.is_disk(i) {
                     *wall_law
                 } else {
-                    Law { k_r: 0.0, ..*wall_law }
+                    Law {
+                        k_r: 0.0,
+                        ..*wall_law
+                    }
                 };
                 m_eff = g.mass[i];
                 r_eff = g.radius[i];
@@ -158,7 +161,10 @@ impl ShapeContacts {
                 law = if g.is_disk(i) && g.is_disk(j) {
                     *grain_law
                 } else {
-                    Law { k_r: 0.0, ..*grain_law }
+                    Law {
+                        k_r: 0.0,
+                        ..*grain_law
+                    }
                 };
                 let (mi, mj) = (g.mass[i], g.mass[j]);
                 m_eff = mi * mj / (mi + mj);
@@ -167,14 +173,8 @@ impl ShapeContacts {
             }
             let motion = Motion {
                 delta: c.delta,
-                u: [
-                    vr[0][0] * nx + vr[0][1] * ny,
-                    vr[1][0] * nx + vr[1][1] * ny,
-                ],
-                v_t: [
-                    vr[0][0] * tx + vr[0][1] * ty,
-                    vr[1][0] * tx + vr[1][1] * ty,
-                ],
+                u: [vr[0][0] * nx + vr[0][1] * ny, vr[1][0] * nx + vr[1][1] * ny],
+                v_t: [vr[0][0] * tx + vr[0][1] * ty, vr[1][0] * tx + vr[1][1] * ty],
                 w,
                 m_eff,
                 r_eff,

@@ -10,9 +10,9 @@
 //!
 //! * area A = ½ Σ c_k;
 //! * centroid **C** = (1/6A) Σ (**p**_k + **p**_{k+1}) c_k;
-//! * polar second moment about the origin J_O = (ρ/12) Σ c_k (**p**_k·**p**_k + **p**_k·**p**_{k+1}
-//!   + **p**_{k+1}·**p**_{k+1}), and about the centroid J = J_O − m|**C**|² (parallel axes),
-//!   m = ρA.
+//! * polar second moment about the origin
+//!   J_O = (ρ/12) Σ c_k (**p**_k·**p**_k + **p**_k·**p**_{k+1} + **p**_{k+1}·**p**_{k+1}),
+//!   and about the centroid J = J_O − m|**C**|² (parallel axes), m = ρA.
 //!
 //! Checks: square of side a, J = m a²/6; right triangle of legs a, b, J = m(a² + b²)/18.
 

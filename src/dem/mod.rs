@@ -15,6 +15,7 @@
 //! * [`packing`]: reproducible packings (gravity deposition, hexagonal);
 //! * [`scale`]: the [`crate::scale::Scale`] implementation (sub-cycling `advance`);
 //! * [`validation`]: validation cases (restitution, incline, conservation, energy budget);
+//! * [`validation_polygon`]: rapier detector against the cell list, polygon physics;
 //! * [`scenario`]: the column-collapse scenario (TOML) and its checks;
 //! * [`run`]: the column-collapse runner (VTK series, time series, summary).
 
@@ -31,6 +32,7 @@ pub mod shape;
 pub mod shape_contacts;
 pub mod solver;
 pub mod validation;
+pub mod validation_polygon;
 pub mod walls;
 
 pub use contact::{damping_ratio, restitution_of, ContactParams};

@@ -100,14 +100,16 @@ fn square_rests_on_floor() {
     assert!(f.abs() < 1e-9 && y.abs() < 1e-9 && w < 1e-12 && th < 1e-12 && n == 2);
 }
 
-/// Square on a rough incline (μ = 0.5): at 20° < atan μ it sticks; at 35° it slides with
-/// a/g = sin θ − μ cos θ within 0.5 % (issue 3).
+/// Square on a rough incline (μ = 0.5): at 20° < atan μ it sticks (creep < 1e-6 m over 0.6 s,
+/// where sliding without friction would cover 0.6 m; the residual velocity is the undamped
+/// tangential-spring oscillation, < 1e-5 m/s); at 35° it slides with a/g = sin θ − μ cos θ
+/// within 0.5 % (issue 3).
 #[test]
 fn square_on_frictional_incline() {
     let mu = 0.5;
     let (_, v, dx) = vp::measure_square_incline(20.0, mu).unwrap();
     println!("20°: v = {v:.2e} m/s, creep {dx:.2e} m over 0.6 s");
-    assert!(v.abs() < 1e-6 && dx.abs() < 1e-6);
+    assert!(v.abs() < 1e-5 && dx.abs() < 1e-6);
     let th = 35f64.to_radians();
     let (a, _, _) = vp::measure_square_incline(35.0, mu).unwrap();
     let want = th.sin() - mu * th.cos();
@@ -116,6 +118,20 @@ fn square_on_frictional_incline() {
         a / want - 1.0
     );
     assert!((a / want - 1.0).abs() < 5e-3);
+}
+
+/// A square falling flat onto the floor (two contact points, each with half the mass) rebounds
+/// with the set e, within 1 % (as `dem-restitution`) for e = 0.3, 0.5, 0.9.
+#[test]
+fn flat_square_impact_restitution() {
+    for e in [0.3, 0.5, 0.9] {
+        let r = vp::measure_flat_impact(e).unwrap();
+        println!(
+            "flat square impact: e = {e}, rebound {r:.5} (rel. {:.1e})",
+            r / e - 1.0
+        );
+        assert!((r / e - 1.0).abs() < 1e-2);
+    }
 }
 
 /// Off-centre square–triangle collision with friction and damping: momentum (1e-13) and

@@ -23,8 +23,9 @@
 //! (ξ unchanged, so a flat impact rebounds with the set e; with m_eff per point the damping
 //! ratio would be √n ξ: e = 0.5 gave 0.365). History is carried from
 //! one step to the next by a linear merge of the sorted contact lists (no hashing).
-//! A point that disappears from rapier's manifold while touching (its feature pair changed)
-//! loses its history without an end-of-contact trapezoid.
+//! A point whose feature pair changed while touching (as two faces slide, the clipping points
+//! switch between vertices of either polygon) hands its history to the nearest new point of the
+//! same pair; a touching point with no successor loses it without an end-of-contact trapezoid.
 //!
 //! The loop is serial (polygon systems are small here); its cost is dominated by rapier.
 
@@ -79,6 +80,13 @@ pub struct ShapeContacts {
     events: Vec<ShapeEvent>,
     /// Points in contact of each entry's pair (the mass share 1/n).
     share: Vec<u32>,
+    /// Scratch of the history merge: old entries matched; new entries without a key match.
+    used: Vec<bool>,
+    fresh: Vec<u32>,
+    /// Histories handed from a point to a new point of the same pair (feature change), total.
+    pub handovers: u64,
+    /// Touching points that vanished from rapier's manifolds without a successor, total.
+    pub lost: u64,
 }
 
 impl ShapeContacts {
@@ -94,6 +102,10 @@ impl ShapeContacts {
             old_state: Vec::new(),
             events: Vec::new(),
             share: Vec::new(),
+            used: Vec::new(),
+            fresh: Vec::new(),
+            handovers: 0,
+            lost: 0,
         }
     }
 
@@ -115,18 +127,57 @@ impl ShapeContacts {
         self.det.detect(g, walls, &mut self.found);
         // History: both lists sorted by (i, j, key).
         self.state.clear();
+        self.used.clear();
+        self.used.resize(self.old.len(), false);
+        self.fresh.clear();
         let mut o = 0;
-        for c in &self.found {
+        for (p, c) in self.found.iter().enumerate() {
             let k = c.order();
             while o < self.old.len() && self.old[o].order() < k {
                 o += 1;
             }
             self.state
                 .push(if o < self.old.len() && self.old[o].order() == k {
+                    self.used[o] = true;
                     self.old_state[o]
                 } else {
+                    self.fresh.push(p as u32);
                     ContactState::default()
                 });
+        }
+        // A point whose feature pair changed (e.g. a clipping vertex of one polygon handing
+        // over to one of the other as they slide) keeps the history of the nearest point of
+        // the same pair that was touching and found no match.
+        let mut o = 0;
+        for &p in &self.fresh {
+            let c = self.found[p as usize];
+            while o < self.old.len() && (self.old[o].i, self.old[o].j) < (c.i, c.j) {
+                o += 1;
+            }
+            let mut best = (f64::INFINITY, usize::MAX);
+            let mut q = o;
+            while q < self.old.len() && (self.old[q].i, self.old[q].j) == (c.i, c.j) {
+                if !self.used[q] && self.old_state[q].touching() {
+                    let (dx, dy) = (
+                        self.old[q].point[0] - c.point[0],
+                        self.old[q].point[1] - c.point[1],
+                    );
+                    if dx * dx + dy * dy < best.0 {
+                        best = (dx * dx + dy * dy, q);
+                    }
+                }
+                q += 1;
+            }
+            if best.1 != usize::MAX {
+                self.used[best.1] = true;
+                self.state[p as usize] = self.old_state[best.1];
+                self.handovers += 1;
+            }
+        }
+        for (u, st) in self.used.iter().zip(&self.old_state) {
+            if !u && st.touching() {
+                self.lost += 1;
+            }
         }
         // Points in contact per pair (groups of equal (i, j) are contiguous).
         self.share.clear();

@@ -277,9 +277,10 @@ pub fn measure_disk_wedge() -> Result<(f64, f64, usize)> {
 
 /// Settling of a mixed pile in a 6-wide box with a triangular polygon wall on the floor: 30
 /// grains (squares, triangles, pentagons, disks; random angles and spins), k_n = 2e4, e = 0.5,
-/// μ = 0.5, rolling resistance for disks, `time` simulated seconds. Returns
-/// (abs(E_tot(end) − E_tot(0))/D, K_end/D, whether a grain touched the polygon wall).
-pub fn measure_pile_budget(time: f64) -> Result<(f64, f64, bool)> {
+/// μ = 0.5, rolling resistance for disks, `time` simulated seconds at Δt = λΔt_cr. Returns
+/// (abs(E_tot(end) − E_tot(0))/D, K_end/D, whether a grain touched the polygon wall, history
+/// handovers between feature pairs, touching points lost without a successor).
+pub fn measure_pile_budget(time: f64, lambda: f64) -> Result<(f64, f64, bool, u64, u64)> {
     let mut g = Grains::new();
     let sq = g
         .polygons
@@ -317,7 +318,9 @@ pub fn measure_pile_budget(time: f64) -> Result<(f64, f64, bool)> {
         rolling_friction: 0.1,
         ..frictional(2e4, 0.5, 0.5)
     };
-    let mut dem = Dem::new(g, walls, DemParams::new(c, c, [0.0, -G]))?;
+    let mut p = DemParams::new(c, c, [0.0, -G]);
+    p.lambda = lambda;
+    let mut dem = Dem::new(g, walls, p)?;
     let e0 = dem.energy();
     let mut poly_wall = false;
     for _ in 0..(time / dem.dt()) as u64 {
@@ -330,10 +333,15 @@ pub fn measure_pile_budget(time: f64) -> Result<(f64, f64, bool)> {
     }
     let e = dem.energy();
     let d = e.dissipated();
+    let (handed, lost) = dem
+        .shape_contacts()
+        .map_or((0, 0), |sc| (sc.handovers, sc.lost));
     Ok((
         (e.total() - e0.total()).abs() / d,
         e.kinetic_total() / d,
         poly_wall,
+        handed,
+        lost,
     ))
 }
 
@@ -491,7 +499,7 @@ pub fn polygons(_f: Fidelity) -> Result<Vec<Check>> {
         1.0,
         0.0,
     ));
-    let (err, k, touched) = measure_pile_budget(3.0)?;
+    let (err, k, touched, _, _) = measure_pile_budget(3.0, 0.1)?;
     out.push(Check::at_most(CASE, "mixed pile: |ΔE_tot|/D", err, 1e-2));
     out.push(Check::at_most(
         CASE,

@@ -78,6 +78,9 @@ pub struct ShapeContacts {
     old: Vec<Contact>,
     old_state: Vec<ContactState>,
     events: Vec<ShapeEvent>,
+    /// Sum per grain of this evaluation's forces [F_x, F_y, torque] (the second half-kick's
+    /// F^end, like the pair lists' `out`).
+    per_grain: Vec<[f64; 3]>,
     /// Points in contact of each entry's pair (the mass share 1/n).
     share: Vec<u32>,
     /// Scratch of the history merge: old entries matched; new entries without a key match.
@@ -101,6 +104,7 @@ impl ShapeContacts {
             old: Vec::new(),
             old_state: Vec::new(),
             events: Vec::new(),
+            per_grain: Vec::new(),
             share: Vec::new(),
             used: Vec::new(),
             fresh: Vec::new(),
@@ -110,12 +114,12 @@ impl ShapeContacts {
     }
 
     /// Detect, carry history over, resolve every contact over a step `h` (0: evaluate only)
-    /// and add the forces to `g.fx`, `g.fy`, `g.torque`. `vp` are the predictor velocities
-    /// (x, y, ω) of the solver.
+    /// and sum the forces per grain into [`ShapeContacts::grain_force`], which the solver's
+    /// per-grain gather adds. `vp` are the predictor velocities (x, y, ω) of the solver.
     #[allow(clippy::too_many_arguments)]
     pub fn evaluate(
         &mut self,
-        g: &mut Grains,
+        g: &Grains,
         walls: &[Wall],
         vp: (&[f64], &[f64], &[f64]),
         grain_law: &Law,
@@ -196,6 +200,8 @@ impl ShapeContacts {
         }
         self.force.clear();
         self.events.clear();
+        self.per_grain.clear();
+        self.per_grain.resize(g.len(), [0.0; 3]);
         let (vxp, vyp, wp) = vp;
         let mut sums = ShapeSums::default();
         for ((c, st), &share) in self
@@ -262,15 +268,16 @@ impl ShapeContacts {
             let [an, at, ar] = r.apply;
             let f = [-an * nx + at * tx, -an * ny + at * ty];
             self.force.push(f);
-            g.fx[i] += f[0];
-            g.fy[i] += f[1];
-            g.torque[i] += cross(ri, f) + ar;
+            let q = &mut self.per_grain[i];
+            q[0] += f[0];
+            q[1] += f[1];
+            q[2] += cross(ri, f) + ar;
             let j = if wall.is_some() { u32::MAX } else { c.j };
             if j != u32::MAX {
-                let j = j as usize;
-                g.fx[j] -= f[0];
-                g.fy[j] -= f[1];
-                g.torque[j] += -cross(rj, f) - ar;
+                let q = &mut self.per_grain[j as usize];
+                q[0] -= f[0];
+                q[1] -= f[1];
+                q[2] += -cross(rj, f) - ar;
             }
             if r.event {
                 let (dn, dt, dm) = (st.f_n - an, st.f_t - at, st.m_r - ar);
@@ -290,6 +297,12 @@ impl ShapeContacts {
             sums.contacts += usize::from(r.touching);
         }
         sums
+    }
+
+    /// Contact force and torque per grain of the last evaluation, [F_x, F_y, T] (empty before
+    /// the first).
+    pub fn grain_force(&self) -> &[[f64; 3]] {
+        &self.per_grain
     }
 
     /// Turn the forces of onset/end steps from **F**^end into **F**_{k+1} (after the kick).

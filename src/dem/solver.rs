@@ -719,6 +719,14 @@ impl Dem {
             })
             .collect_into_vec(&mut self.parts);
         total = self.parts.iter().fold(total, |a, b| a.merge(b));
+        // Contacts through rapier (polygon grains or walls), summed per grain for the gather.
+        if let Some(sc) = self.shapes.as_mut() {
+            let vp = (&self.vxp[..], &self.vyp[..], &self.wp[..]);
+            let (gl, wl) = (&self.grain_law, &self.wall_law);
+            let s = sc.evaluate(&self.grains, &self.walls, vp, gl, wl, dt_hist);
+            total = total.add_shapes(&s);
+        }
+        let sf: &[[f64; 3]] = self.shapes.as_ref().map_or(&[], |s| s.grain_force());
         // Gather per grain: gravity, global damping, external loads, contacts.
         let grav = self.params.gravity;
         let alpha = self.params.global_damping;
@@ -784,6 +792,11 @@ impl Dem {
                             t += q[2];
                         }
                     }
+                    if let Some(q) = sf.get(i) {
+                        f[0] += q[0];
+                        f[1] += q[1];
+                        t += q[2];
+                    }
                     fx[k] = f[0];
                     fy[k] = f[1];
                     tq[k] = t;
@@ -795,12 +808,6 @@ impl Dem {
             .gparts
             .iter()
             .fold((0.0, 0.0), |a, b| (a.0 + b[0], a.1 + b[1]));
-        if let Some(sc) = self.shapes.as_mut() {
-            let vp = (&self.vxp[..], &self.vyp[..], &self.wp[..]);
-            let (gl, wl) = (&self.grain_law, &self.wall_law);
-            let s = sc.evaluate(&mut self.grains, &self.walls, vp, gl, wl, dt_hist);
-            total = total.add_shapes(&s);
-        }
         let b = &mut self.budget;
         b.elastic_normal = total.e_n;
         b.elastic_tangential = total.e_t;

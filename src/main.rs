@@ -99,6 +99,24 @@ enum Bench {
         #[arg(long)]
         json: bool,
     },
+    /// DEM: the LAMMPS `in.gran2d.lmp` case (hex block of disks collapsing between walls).
+    Dem {
+        /// Number of grains (a √N × √N hex block).
+        #[arg(long, default_value_t = 10_000)]
+        grains: usize,
+        /// Timed steps per repeat (after 500 warm-up steps).
+        #[arg(long, default_value_t = 5000)]
+        steps: u64,
+        /// Threads (0: all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Repeats (each a fresh block); the median is reported.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -418,6 +436,26 @@ fn bench(which: Bench) -> Result<ExitCode> {
                 println!(
                     "lbm {}×{} {} {} on {} threads: {:.1} MLUPS (samples {:?}); copy {:.1} GB/s; {} B/cell; {:.0} % of roofline",
                     r.nx, r.ny, r.precision, r.collision, r.threads, r.mlups, r.samples.iter().map(|s| (s * 10.0).round() / 10.0).collect::<Vec<_>>(), r.copy_gb_s, r.bytes_per_cell, 100.0 * r.roofline_fraction
+                );
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Bench::Dem {
+            grains,
+            steps,
+            threads,
+            repeats,
+            json,
+        } => {
+            let r = granflow::dem::bench::run(grains, steps, threads, repeats)?;
+            if json {
+                println!("{}", serde_json::to_string(&r)?);
+            } else {
+                println!(
+                    "dem {} grains, {} steps on {} threads: {:.3e} particle-steps/s (samples {:?}); {:.0} contacts/step; {:.3} list builds/step",
+                    r.grains, r.steps, r.threads, r.particle_steps_per_s,
+                    r.samples.iter().map(|s| format!("{s:.3e}")).collect::<Vec<_>>(),
+                    r.contacts_per_step, r.list_builds_per_step
                 );
             }
             Ok(ExitCode::SUCCESS)

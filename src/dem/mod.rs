@@ -1,5 +1,6 @@
 //! Discrete element method for disks and convex polygons (seed eq. 5.55–5.61).
 //!
+//! * [`bench`]: the `granflow bench dem` case (LAMMPS `in.gran2d.lmp`);
 //! * [`grains`]: the grains (disks or convex polygons) as a structure of arrays;
 //! * [`shape`]: the shared polygon table and polygon mass properties;
 //! * [`contact`]: the contact law (linear spring-dashpot normal force with the damping set by a
@@ -12,6 +13,7 @@
 //! * [`shape_contacts`]: contact history and forces of the pairs rapier finds;
 //! * [`solver`]: the system [`Dem`] and its velocity-Verlet step;
 //! * [`energy`]: the energy budget;
+//! * [`stress`]: per-grain Love–Weber stress tensor;
 //! * [`packing`]: reproducible packings (gravity deposition, hexagonal);
 //! * [`scale`]: the [`crate::scale::Scale`] implementation (sub-cycling `advance`);
 //! * [`validation`]: validation cases (restitution, incline, conservation, energy budget);
@@ -19,6 +21,7 @@
 //! * [`scenario`]: the column-collapse scenario (TOML) and its checks;
 //! * [`run`]: the column-collapse runner (VTK series, time series, summary).
 
+pub mod bench;
 pub mod contact;
 pub mod detect_rapier;
 pub mod energy;
@@ -31,6 +34,7 @@ pub mod scenario;
 pub mod shape;
 pub mod shape_contacts;
 pub mod solver;
+pub mod stress;
 pub mod validation;
 pub mod validation_polygon;
 pub mod walls;

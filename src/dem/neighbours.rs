@@ -30,8 +30,13 @@ pub struct PairList {
     /// Contact state of each pair: last overlap, springs, forces (see [`ContactState`]).
     pub state: Vec<ContactState>,
     /// Forces of each pair applied in the last second half-kick: [F_x on i, F_y on i,
-    /// torque on i, torque on j] (the force on j is the opposite).
+    /// torque on i, torque on j] (the force on j is the opposite); valid where `flags` has
+    /// [`PAIR_ACTIVE`] (pairs apart before and after the step are skipped, `out` left stale).
     pub out: Vec<[f64; 4]>,
+    /// Per pair: [`PAIR_ACTIVE`] if `out` holds this evaluation's force, [`PAIR_TOUCHING`] if
+    /// the grains overlapped at the last evaluation (the same as `state[p].touching()`, kept in
+    /// one byte so the force loop skips the many apart pairs without loading their state).
+    pub flags: Vec<u8>,
     /// Pairs whose first grain is `g` are `first[g]..first[g + 1]`.
     pub first: Vec<u32>,
     /// Pairs whose second grain is `g` are `as_j[j_start[g]..j_start[g + 1]]`.
@@ -39,6 +44,11 @@ pub struct PairList {
     /// Pair indices grouped by second grain.
     pub as_j: Vec<u32>,
 }
+
+/// [`PairList::flags`] bit: `out` holds this evaluation's force.
+pub const PAIR_ACTIVE: u8 = 1;
+/// [`PairList::flags`] bit: the grains overlapped at the last evaluation.
+pub const PAIR_TOUCHING: u8 = 2;
 
 /// Grain–wall pairs within reach, sorted by (grain, wall).
 #[derive(Clone, Debug, Default)]
@@ -98,6 +108,12 @@ impl Detector {
                 let r2 = dx * dx + dy * dy;
                 r2 > lim || r2.is_nan()
             })
+    }
+
+    /// Positions at the last build and the squared displacement (skin/2)² beyond which the
+    /// list must be rebuilt (empty slices before the first build).
+    pub fn reference(&self) -> (&[f64], &[f64], f64) {
+        (&self.x_ref, &self.y_ref, 0.25 * self.skin * self.skin)
     }
 
     /// Rebuild both lists from the current positions, carrying history over.
@@ -240,6 +256,12 @@ impl Detector {
         }
         pl.out.clear();
         pl.out.resize(m, [0.0; 4]);
+        pl.flags.clear();
+        pl.flags.extend(
+            pl.state
+                .iter()
+                .map(|s| if s.touching() { PAIR_TOUCHING } else { 0 }),
+        );
         // Index by first grain.
         pl.first.clear();
         pl.first.resize(n + 1, 0);

@@ -2,9 +2,11 @@
 //! integrate until the mass is at rest, and write
 //!
 //! * `series.pvd` with, per frame, `grains_NNNNNN.vtu` (part 0: points with radius, velocity,
-//!   angular velocity, contact count) and `contacts_NNNNNN.vtu` (part 1: a line cell per
-//!   touching grain–grain pair joining the two centres, with the normal and tangential force
-//!   magnitudes f_n, f_t — force chains in ParaView);
+//!   angular velocity, contact count, Love–Weber stress tensor and its mean −(σ_xx + σ_yy)/2,
+//!   see [`super::stress`]) and `contacts_NNNNNN.vtu` (part 1: a line cell per touching pair —
+//!   grain–grain from centre to centre, grain–wall from the centre to the contact point on
+//!   the wall — with the normal and tangential forces f_n, f_t and `wall` = 1 for wall
+//!   contacts: force chains in ParaView);
 //! * `timeseries.csv`: t, t/τ_c, run-out, front, height, energies, budget error;
 //! * `summary.json` ([`CollapseSummary`]).
 //!
@@ -25,6 +27,7 @@ use serde::Serialize;
 use super::packing::deposit_column;
 use super::scenario::DemScenario;
 use super::solver::Dem;
+use super::stress::grain_stress;
 use super::walls::Wall;
 use crate::io::{write_json, write_vtu_points, CsvWriter, Field, PvdSeries};
 use crate::{Error, Result};
@@ -139,8 +142,10 @@ fn shape(dem: &Dem) -> Shape {
 fn write_frame(dem: &Dem, s: &Shape, dir: &Path, k: usize, pvd: &mut PvdSeries) -> Result<()> {
     let g = &dem.grains;
     let n = g.len();
-    let points: Vec<[f64; 2]> = (0..n).map(|i| [g.x[i], g.y[i]]).collect();
+    let mut points: Vec<[f64; 2]> = (0..n).map(|i| [g.x[i], g.y[i]]).collect();
     let vel: Vec<[f64; 2]> = (0..n).map(|i| [g.vx[i], g.vy[i]]).collect();
+    let stress = grain_stress(dem);
+    let pressure: Vec<f64> = stress.iter().map(|t| -0.5 * (t[0] + t[3])).collect();
     let gname = format!("grains_{k:06}.vtu");
     write_vtu_points(
         &dir.join(&gname),
@@ -150,27 +155,44 @@ fn write_frame(dem: &Dem, s: &Shape, dir: &Path, k: usize, pvd: &mut PvdSeries) 
             Field::vector("velocity", &vel),
             Field::scalar("angular_velocity", &g.omega),
             Field::scalar("contacts", &s.contacts),
+            Field::tensor("stress", &stress),
+            Field::scalar("mean_pressure", &pressure),
         ],
         &[],
         &[],
     )?;
+    let (mut lines, mut f_n, mut f_t, mut wall) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let pl = dem.pairs();
-    let (mut lines, mut f_n, mut f_t) = (Vec::new(), Vec::new(), Vec::new());
     for p in 0..pl.i.len() {
         let st = &pl.state[p];
         if st.touching() {
             lines.push([pl.i[p], pl.j[p]]);
             f_n.push(st.f_n);
             f_t.push(st.f_t);
+            wall.push(0.0);
+        }
+    }
+    let wl = dem.wall_pairs();
+    for p in 0..wl.grain.len() {
+        let st = &wl.state[p];
+        if st.touching() {
+            let i = wl.grain[p] as usize;
+            let (dist, nrm) = dem.walls[wl.wall[p] as usize].distance([g.x[i], g.y[i]]);
+            lines.push([i as u32, points.len() as u32]);
+            points.push([g.x[i] + dist * nrm[0], g.y[i] + dist * nrm[1]]);
+            f_n.push(st.f_n);
+            f_t.push(st.f_t);
+            wall.push(1.0);
         }
     }
     let cname = format!("contacts_{k:06}.vtu");
     // With no touching pair, write the points only (a valid vertex set).
-    let (cf_n, cf_t) = (
+    let fields = [
         Field::scalar("normal_force", &f_n),
         Field::scalar("tangential_force", &f_t),
-    );
-    let cells: &[Field] = if lines.is_empty() { &[] } else { &[cf_n, cf_t] };
+        Field::scalar("wall", &wall),
+    ];
+    let cells: &[Field] = if lines.is_empty() { &[] } else { &fields };
     write_vtu_points(&dir.join(&cname), &points, &[], &lines, cells)?;
     pvd.add(dem.time(), 0, &gname)?;
     pvd.add(dem.time(), 1, &cname)

@@ -29,9 +29,9 @@
 use rayon::prelude::*;
 
 use super::contact::{self, ContactOut, ContactParams, Law, Motion};
+use super::detect_rapier::RapierDetector;
 use super::energy::Energy;
 use super::grains::Grains;
-use super::detect_rapier::RapierDetector;
 use super::neighbours::{Detector, PairList, WallList, PAIR_ACTIVE, PAIR_TOUCHING};
 use super::shape_contacts::{ShapeContacts, ShapeSums};
 use super::walls::Wall;

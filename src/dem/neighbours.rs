@@ -193,13 +193,15 @@ impl Detector {
         let nchunks = n.div_ceil(CHUNK).max(1);
         self.bufs.resize_with(nchunks, Vec::new);
         let (cell_start, sorted, cell_of) = (&self.cell_start, &self.sorted, &self.cell_of);
+        // Pairs with a polygon grain belong to the rapier detector (`detect_rapier`).
+        let polys = g.has_polygons();
         self.bufs.par_iter_mut().enumerate().for_each(|(k, buf)| {
             buf.clear();
             let mut mine: Vec<u32> = Vec::with_capacity(16);
             #[allow(clippy::needless_range_loop)]
             for i in k * CHUNK..((k + 1) * CHUNK).min(n) {
                 let c = cell_of[i];
-                if c == u32::MAX {
+                if c == u32::MAX || (polys && !g.is_disk(i)) {
                     continue;
                 }
                 let (cx, cy) = ((c as usize) % ncx, (c as usize) / ncx);
@@ -209,7 +211,7 @@ impl Detector {
                     for nx in cx.saturating_sub(1)..=(cx + 1).min(ncx - 1) {
                         let cc = ny * ncx + nx;
                         for &j in &sorted[cell_start[cc] as usize..cell_start[cc + 1] as usize] {
-                            if j as usize <= i {
+                            if j as usize <= i || (polys && !g.is_disk(j as usize)) {
                                 continue;
                             }
                             let j_ = j as usize;
@@ -299,6 +301,9 @@ impl Detector {
         wl.first.resize(n + 1, 0);
         let mut o = 0;
         for k in 0..n {
+            // Polygon grains meet walls through the rapier detector; polygon walls report
+            // s = ∞ and are never paired here.
+            let walls = if g.is_disk(k) { walls } else { &[] };
             for (w, wall) in walls.iter().enumerate() {
                 let (s, _) = wall.distance([g.x[k], g.y[k]]);
                 if s < g.radius[k] + self.skin {

@@ -29,9 +29,11 @@
 use rayon::prelude::*;
 
 use super::contact::{self, ContactOut, ContactParams, Law, Motion};
+use super::detect_rapier::RapierDetector;
 use super::energy::Energy;
 use super::grains::Grains;
 use super::neighbours::{Detector, PairList, WallList, PAIR_ACTIVE, PAIR_TOUCHING};
+use super::shape_contacts::{ShapeContacts, ShapeSums};
 use super::walls::Wall;
 use crate::{Error, Result};
 
@@ -102,6 +104,18 @@ pub fn critical_step(p: &DemParams, m_min: f64, j_min: f64) -> f64 {
     dt
 }
 
+/// Smallest effective mass of a polygon grain at a contact point (∞ if none):
+/// m_c = 1/(1/m + R_b²/J), R_b the bounding radius — a point on a rotating body is lighter than
+/// its mass (a disk's contact point has m/3 tangentially, which [`critical_step`] already
+/// builds in through 3k_t). Passed as m_min for polygons, it makes the normal and tangential
+/// critical steps conservative.
+fn polygon_contact_mass(g: &Grains) -> f64 {
+    (0..g.len())
+        .filter(|&i| !g.is_disk(i))
+        .map(|i| 1.0 / (1.0 / g.mass[i] + g.radius[i] * g.radius[i] / g.inertia[i]))
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// External loads held during [`Dem::advance_with`] (e.g. hydrodynamic force and torque from
 /// the fluid, seed eq. 5.53–5.54). Empty vectors mean none.
 #[derive(Clone, Debug, Default)]
@@ -146,6 +160,17 @@ impl Part {
         self.d_f += o.d_friction;
         self.d_r += o.d_rolling;
         self.contacts += f64::from(u8::from(o.touching));
+        self
+    }
+
+    fn add_shapes(mut self, o: &ShapeSums) -> Self {
+        self.e_n += o.e_n;
+        self.e_t += o.e_t;
+        self.e_r += o.e_r;
+        self.d_n += o.d_n;
+        self.d_f += o.d_f;
+        self.d_r += o.d_r;
+        self.contacts += o.contacts as f64;
         self
     }
 
@@ -201,6 +226,9 @@ pub struct Dem {
     /// filled in by [`Dem::energy`].
     budget: Energy,
     contacts: usize,
+    /// Pairs the cell list does not handle (polygon grains, polygon walls), through rapier;
+    /// `None` for an all-disk system with straight walls.
+    shapes: Option<ShapeContacts>,
 }
 
 impl Dem {
@@ -251,7 +279,11 @@ impl Dem {
                 ));
             }
         }
-        let dt_cr = critical_step(&params, grains.min_mass(), grains.min_inertia());
+        let dt_cr = critical_step(
+            &params,
+            grains.min_mass().min(polygon_contact_mass(&grains)),
+            grains.min_inertia(),
+        );
         let dt_max = params.lambda * dt_cr;
         let dt = match params.dt {
             Some(dt) if !(dt > 0.0 && dt.is_finite()) => {
@@ -277,7 +309,9 @@ impl Dem {
             }
         };
         let skin = params.skin_fraction * 2.0 * grains.max_radius().max(f64::MIN_POSITIVE);
+        let shapes = RapierDetector::needed(&grains, &walls).then(|| ShapeContacts::new(skin));
         Ok(Dem {
+            shapes,
             grain_law: Law::from(&params.grain),
             wall_law: Law::from(&params.wall),
             grains,
@@ -350,6 +384,12 @@ impl Dem {
     /// Grain–grain pairs in the neighbour list (with history and last forces).
     pub fn pairs(&self) -> &PairList {
         &self.pairs
+    }
+
+    /// Contacts found by the rapier detector (polygon grains, polygon walls); `None` when the
+    /// system needs none.
+    pub fn shape_contacts(&self) -> Option<&ShapeContacts> {
+        self.shapes.as_ref()
     }
 
     /// Grain–wall pairs in the neighbour list.
@@ -551,6 +591,9 @@ impl Dem {
                 g.torque[j] += d[3];
             }
         }
+        if let Some(sc) = &self.shapes {
+            sc.apply_events(g);
+        }
     }
 
     /// Steps 3–5: rebuild the lists if needed, evaluate all forces at the current positions
@@ -714,6 +757,14 @@ impl Dem {
             })
             .collect_into_vec(&mut self.parts);
         total = self.parts.iter().fold(total, |a, b| a.merge(b));
+        // Contacts through rapier (polygon grains or walls), summed per grain for the gather.
+        if let Some(sc) = self.shapes.as_mut() {
+            let vp = (&self.vxp[..], &self.vyp[..], &self.wp[..]);
+            let (gl, wl) = (&self.grain_law, &self.wall_law);
+            let s = sc.evaluate(&self.grains, &self.walls, vp, gl, wl, dt_hist);
+            total = total.add_shapes(&s);
+        }
+        let sf: &[[f64; 3]] = self.shapes.as_ref().map_or(&[], |s| s.grain_force());
         // Gather per grain: gravity, global damping, external loads, contacts; then kick.
         let grav = self.params.gravity;
         let alpha = self.params.global_damping;
@@ -785,6 +836,11 @@ impl Dem {
                             f[1] += q[1];
                             t += q[2];
                         }
+                    }
+                    if let Some(q) = sf.get(i) {
+                        f[0] += q[0];
+                        f[1] += q[1];
+                        t += q[2];
                     }
                     fx[k] = f[0];
                     fy[k] = f[1];

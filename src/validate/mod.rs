@@ -306,6 +306,11 @@ pub const CASES: &[Case] = &[
         description: "DEM energy budget of a settling run closes within 1 %",
         run: |f| checks_only(crate::dem::validation::energy_budget(f)),
     },
+    Case {
+        name: "dem-polygon",
+        description: "rapier2d detector = cell list on disks; polygon grains: rest, rough incline, momentum, budget",
+        run: |f| checks_only(crate::dem::validation_polygon::polygons(f)),
+    },
 ];
 
 /// A report of checks without figures.

@@ -22,6 +22,7 @@ use rayon::prelude::*;
 use super::boundary::{zou_he, Edge, Edges, Neighbour, ZouHe, ZouHeNode};
 use super::collision::Collider;
 use super::d2q9::{equilibrium, CX, CY, OPP, Q, W};
+use super::partial::{self, PartialCells};
 use super::real::Real;
 
 /// Nodes collided together as the lanes of one vector in the special-node path.
@@ -425,6 +426,136 @@ impl<T: Real> Lattice<T> {
         self.even = !even;
     }
 
+    /// One fused stream–collide step in which the cells of `psm` collide as partially
+    /// saturated cells ([`super::partial`]) and record the momentum exchanged with the solid in
+    /// `psm.exchange`. Streaming is unchanged: a covered cell streams like the fluid node it is.
+    /// With no covered cells this is [`Lattice::step`].
+    pub fn step_partial(&mut self, collider: &Collider<T>, psm: &mut PartialCells<T>) {
+        if psm.is_empty() {
+            return self.step(collider);
+        }
+        psm.index_rows(self.nx, self.ny);
+        let (nx, ny, n, even) = (self.nx, self.ny, self.stride, self.even);
+        self.zh_shift = [0.5 * collider.force[0], 0.5 * collider.force[1]];
+        let zh_shift = self.zh_shift;
+        let base = Shared(self.f.as_mut_ptr());
+        let exchange = Shared(psm.exchange.as_mut_ptr());
+        let (specials, special_of, solid) = (&self.specials, &self.special_of, &self.solid);
+        let wall_corr = &self.wall_corr;
+        let psm = &*psm;
+        self.rows.par_iter().enumerate().for_each(|(y, plan)| {
+            let (runs, group_list) = if even {
+                (&plan.even_runs, &plan.even_specials)
+            } else {
+                (&plan.runs, &plan.specials)
+            };
+            let (k0, k1) = (psm.row_start[y] as usize, psm.row_start[y + 1] as usize);
+            let covered = &psm.cells[k0..k1];
+            let is_covered = |c: u32| covered.binary_search(&c).is_ok();
+            let row = (y * nx) as u32;
+            let bulk = |x0: usize, x1: usize| {
+                // SAFETY: as in `step`.
+                unsafe {
+                    if bulk_lanes::<T>() == 32 {
+                        bulk_run::<T, 32>(base.get(), n, nx, ny, y, x0, x1, even, collider)
+                    } else {
+                        bulk_run::<T, 16>(base.get(), n, nx, ny, y, x0, x1, even, collider)
+                    }
+                }
+            };
+            // Bulk runs, cut around the covered cells.
+            for &(x0, x1) in runs {
+                let mut start = x0;
+                for &c in covered {
+                    let x = c - row;
+                    if x >= x0 && x < x1 {
+                        if x > start {
+                            bulk(start as usize, x as usize);
+                        }
+                        start = x + 1;
+                    }
+                }
+                if start < x1 {
+                    bulk(start as usize, x1 as usize);
+                }
+            }
+            // Special nodes that are not covered, in groups of LANES.
+            let mut group = [0u32; LANES];
+            let mut len = 0;
+            for &s in group_list {
+                if is_covered(specials[s as usize].cell) {
+                    continue;
+                }
+                group[len] = s;
+                len += 1;
+                if len == LANES {
+                    // SAFETY: as in `step`.
+                    unsafe {
+                        special_nodes(
+                            base.get(),
+                            n,
+                            specials,
+                            &group,
+                            even,
+                            collider,
+                            wall_corr,
+                            zh_shift,
+                        )
+                    };
+                    len = 0;
+                }
+            }
+            if len > 0 {
+                // SAFETY: as in `step`.
+                unsafe {
+                    special_nodes(
+                        base.get(),
+                        n,
+                        specials,
+                        &group[..len],
+                        even,
+                        collider,
+                        wall_corr,
+                        zh_shift,
+                    )
+                };
+            }
+            // Covered nodes.
+            for k in k0..k1 {
+                let c = psm.cells[k] as usize;
+                if solid[c] {
+                    continue;
+                }
+                let s = special_of[c];
+                let bulk_node;
+                let sp = if s != u32::MAX {
+                    &specials[s as usize]
+                } else {
+                    // A bulk node: its eight neighbours are fluid and inside the row range.
+                    let x = c % nx;
+                    bulk_node = Special {
+                        cell: c as u32,
+                        nb: std::array::from_fn(|i| {
+                            let yy = (y as i64 + CY[i] as i64).rem_euclid(ny as i64) as usize;
+                            Neighbour::Fluid((yy * nx + (x as i64 + CX[i] as i64) as usize) as u32)
+                        }),
+                        zou_he: None,
+                    };
+                    &bulk_node
+                };
+                // SAFETY: as in `step`; entry k of `exchange` belongs to this row only.
+                unsafe {
+                    let (g, _) = gather(base.get(), n, sp, even, wall_corr, zh_shift);
+                    let (post, dp) =
+                        partial::collide(&g, psm.b[k], [psm.ux[k], psm.uy[k]], collider);
+                    scatter(base.get(), n, sp, &post, even, wall_corr);
+                    *exchange.get().add(k) = dp;
+                }
+            }
+        });
+        self.even = !even;
+    }
+
     /// Pre-collision populations of fluid cell `c` at the current time (after streaming and
     /// boundary closure): what the next step will collide.
     /// A solid cell has no populations: it reports the rest state at unit density.
@@ -642,6 +773,34 @@ unsafe fn special_nodes<T: Real>(
                     Neighbour::Bounce(w) => *f.add(OPP[i] * n + c) = v - wall_corr[w as usize][i],
                     Neighbour::Open => {}
                 }
+            }
+        }
+    }
+}
+
+/// Write the post-collision populations of one special node (the scatter of
+/// [`special_nodes`]).
+///
+/// # Safety
+/// As [`special_nodes`].
+unsafe fn scatter<T: Real>(
+    f: *mut T,
+    n: usize,
+    sp: &Special,
+    post: &[T; Q],
+    even: bool,
+    wall_corr: &[[T; Q]],
+) {
+    let c = sp.cell as usize;
+    for i in 0..Q {
+        let v = post[i];
+        if even {
+            *f.add(OPP[i] * n + c) = v;
+        } else {
+            match sp.nb[i] {
+                Neighbour::Fluid(k) => *f.add(i * n + k as usize) = v,
+                Neighbour::Bounce(w) => *f.add(OPP[i] * n + c) = v - wall_corr[w as usize][i],
+                Neighbour::Open => {}
             }
         }
     }

@@ -82,6 +82,7 @@ where
         self.fluid.advance(&self.fluid_in, dt)?;
         self.fluid.observe(&mut self.fluid_out);
         self.map.to_solid(&self.fluid_out, &mut self.solid_in);
+        self.solid.input_changed();
         let n = subcycles(dt, self.solid.max_dt());
         let h = dt / n as f64;
         for _ in 0..n {

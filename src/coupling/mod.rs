@@ -14,6 +14,7 @@
 pub mod cover;
 pub mod driver;
 pub mod overlap;
+pub mod validation;
 
 pub use cover::{DiskCover, Grid};
 pub use driver::{subcycles, Coupled, Exchange};

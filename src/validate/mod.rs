@@ -16,6 +16,8 @@ mod les;
 mod poiseuille;
 mod taylor_green;
 
+pub(crate) use cylinder::SANGANI_ACRIVOS;
+
 /// One checked quantity.
 #[derive(Clone, Debug, Serialize)]
 pub struct Check {
@@ -305,6 +307,16 @@ pub const CASES: &[Case] = &[
         name: "dem-energy",
         description: "DEM energy budget of a settling run closes within 1 %",
         run: |f| checks_only(crate::dem::validation::energy_budget(f)),
+    },
+    Case {
+        name: "psm-cylinder-array",
+        description: "partially saturated cells: Sangani–Acrivos drag within 5 %, d ≥ 20 cells",
+        run: crate::coupling::validation::psm_cylinder_array,
+    },
+    Case {
+        name: "coupling-momentum",
+        description: "fluid + grain momentum in a closed periodic box to 1e-10 relative",
+        run: crate::coupling::validation::momentum,
     },
 ];
 

@@ -318,6 +318,11 @@ pub const CASES: &[Case] = &[
         description: "fluid + grain momentum in a closed periodic box to 1e-10 relative",
         run: crate::coupling::validation::momentum,
     },
+    Case {
+        name: "settling-disk",
+        description: "disk settling in a channel: u_t converges with d, vs Faxén's drag",
+        run: crate::coupling::validation::settling,
+    },
 ];
 
 /// A report of checks without figures.

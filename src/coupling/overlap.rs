@@ -125,7 +125,7 @@ mod tests {
         let half = disk_rect([0.5, 0.0], 100.0, 0.0, 1.0, -0.5, 0.5);
         assert!((half - 1.0).abs() < 1e-12);
         let edge = disk_rect([0.0, 0.0], 1.0, 1.0 - 1e-9, 2.0, -1.0, 1.0);
-        assert!(edge >= 0.0 && edge < 1e-12);
+        assert!((0.0..1e-12).contains(&edge));
         // A small disk centred on the line x = 0.5: the right half-disk lies in [0.5, 1] × [0, 1].
         let small = disk_rect([0.5, 0.5], 0.2, 0.5, 1.0, 0.0, 1.0);
         assert!((small - PI * 0.04 / 2.0).abs() < 1e-15);

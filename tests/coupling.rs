@@ -94,3 +94,8 @@ fn zero_weight_is_the_plain_step() {
     zero_weight_matches_plain::<f64>(CollisionModel::Mrt(MrtRates::standard(0.7)), Some(0.1));
     zero_weight_matches_plain::<f32>(CollisionModel::Bgk, Some(0.1));
 }
+
+#[test]
+fn drafting_kissing_tumbling() {
+    assert_passes("dkt");
+}

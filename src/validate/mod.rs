@@ -323,6 +323,11 @@ pub const CASES: &[Case] = &[
         description: "disk settling in a channel: u_t converges with d, vs Faxén's drag",
         run: crate::coupling::validation::settling,
     },
+    Case {
+        name: "dkt",
+        description: "two disks draft, kiss (gap < Δx) and tumble; times reported",
+        run: crate::coupling::validation::dkt,
+    },
 ];
 
 /// A report of checks without figures.

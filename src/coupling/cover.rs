@@ -40,11 +40,12 @@ struct Piece {
     eps: f64,
     /// x_n − x_k (m), before wrapping.
     r: [f64; 2],
-    /// Index of the cell in the cover (set after sorting).
-    slot: u32,
 }
 
 /// Rasterises disks as partially saturated cells and sums cell forces per grain.
+///
+/// Per-cell sums live in dense arrays over the lattice (reset cell by cell after use), so a
+/// step allocates nothing once the buffers have grown and needs no sort of the pieces.
 #[derive(Clone, Debug)]
 pub struct DiskCover {
     /// The lattice.
@@ -52,6 +53,12 @@ pub struct DiskCover {
     /// Hydrodynamic radius factor κ = r/R ∈ (0, 1].
     pub radius_factor: f64,
     pieces: Vec<Piece>,
+    /// Σ_k ε_nk, Σ_k ε_nk u_x, Σ_k ε_nk u_y per cell (dense; zero outside the cover).
+    acc: Vec<[f64; 3]>,
+    /// Cover slot of each cell (dense; valid for covered cells).
+    slot_of: Vec<u32>,
+    /// Cells touched by the last cover.
+    touched: Vec<u32>,
     /// Σ_k ε_nk per cover slot (unclipped).
     total: Vec<f64>,
     /// Grains seen by the last cover.
@@ -67,10 +74,14 @@ impl DiskCover {
                 format!("r/R must be in (0, 1], got {radius_factor}"),
             ));
         }
+        let n = grid.nx * grid.ny;
         Ok(DiskCover {
             grid,
             radius_factor,
             pieces: Vec::new(),
+            acc: vec![[0.0; 3]; n],
+            slot_of: vec![u32::MAX; n],
+            touched: Vec::new(),
             total: Vec::new(),
             grains: 0,
         })
@@ -85,12 +96,14 @@ impl DiskCover {
             periodic,
         } = self.grid;
         self.pieces.clear();
+        self.touched.clear();
         self.grains = g.x.len();
         for k in 0..g.x.len() {
             let r = self.radius_factor * g.radius[k] / dx;
             let (cx, cy) = (g.x[k] / dx, g.y[k] / dx);
             let (i0, i1) = ((cx - r).floor() as i64, (cx + r).floor() as i64);
             let (j0, j1) = ((cy - r).floor() as i64, (cy + r).floor() as i64);
+            let w = g.omega[k];
             for j in j0..=j1 {
                 let Some(jj) = wrap(j, ny, periodic[1]) else {
                     continue;
@@ -102,49 +115,50 @@ impl DiskCover {
                     let (x, y) = (i as f64, j as f64);
                     let eps = disk_rect([cx, cy], r, x, x + 1.0, y, y + 1.0);
                     if eps > 0.0 {
+                        let cell = jj * nx + ii;
+                        let rr = [(x + 0.5 - cx) * dx, (y + 0.5 - cy) * dx];
+                        let a = &mut self.acc[cell];
+                        if a[0] == 0.0 {
+                            self.touched.push(cell as u32);
+                        }
+                        a[0] += eps;
+                        a[1] += eps * (g.vx[k] - w * rr[1]);
+                        a[2] += eps * (g.vy[k] + w * rr[0]);
                         self.pieces.push(Piece {
-                            cell: (jj * nx + ii) as u32,
+                            cell: cell as u32,
                             grain: k as u32,
                             eps,
-                            r: [(x + 0.5 - cx) * dx, (y + 0.5 - cy) * dx],
-                            slot: 0,
+                            r: rr,
                         });
                     }
                 }
             }
         }
-        self.pieces.sort_unstable_by_key(|p| (p.cell, p.grain));
         out.cells.clear();
         out.eps.clear();
         out.ux.clear();
         out.uy.clear();
         self.total.clear();
-        let mut m = [0.0; 3]; // Σ ε, Σ ε u_x, Σ ε u_y of the current cell
-        for q in 0..self.pieces.len() {
-            let p = self.pieces[q];
-            if out.cells.last() != Some(&p.cell) {
-                if !out.cells.is_empty() {
-                    finish(out, &mut self.total, m);
+        // Ascending order: sort the touched cells, or scan the lattice when they are many.
+        if self.touched.len() * 16 > self.acc.len() {
+            self.touched.clear();
+            for (c, a) in self.acc.iter().enumerate() {
+                if a[0] > 0.0 {
+                    self.touched.push(c as u32);
                 }
-                out.cells.push(p.cell);
-                m = [0.0; 3];
             }
-            self.pieces[q].slot = (out.cells.len() - 1) as u32;
-            let k = p.grain as usize;
-            let w = g.omega[k];
-            m[0] += p.eps;
-            m[1] += p.eps * (g.vx[k] - w * p.r[1]);
-            m[2] += p.eps * (g.vy[k] + w * p.r[0]);
+        } else {
+            self.touched.sort_unstable();
         }
-        if !out.cells.is_empty() {
-            finish(out, &mut self.total, m);
-        }
-
-        fn finish(out: &mut SolidCover, total: &mut Vec<f64>, m: [f64; 3]) {
-            out.eps.push(m[0].min(1.0));
-            out.ux.push(m[1] / m[0]);
-            out.uy.push(m[2] / m[0]);
-            total.push(m[0]);
+        for &c in &self.touched {
+            let a = &mut self.acc[c as usize];
+            self.slot_of[c as usize] = out.cells.len() as u32;
+            out.cells.push(c);
+            out.eps.push(a[0].min(1.0));
+            out.ux.push(a[1] / a[0]);
+            out.uy.push(a[2] / a[0]);
+            self.total.push(a[0]);
+            *a = [0.0; 3];
         }
     }
 
@@ -165,7 +179,7 @@ impl DiskCover {
             return;
         }
         for p in &self.pieces {
-            let s = p.slot as usize;
+            let s = self.slot_of[p.cell as usize] as usize;
             let share = p.eps / self.total[s];
             let (fx, fy) = (share * forces.fx[s], share * forces.fy[s]);
             let k = p.grain as usize;

@@ -11,6 +11,7 @@
 //! Buoyancy enters through reduced gravity (1 − ρ_f/ρ_s) g on the grains (seed eq. 5.57); the
 //! fluid then carries no gravity, so there is no hydrostatic pressure to resolve.
 
+pub mod bench;
 pub mod cover;
 pub mod driver;
 pub mod overlap;

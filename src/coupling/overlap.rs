@@ -56,7 +56,9 @@ pub fn disk_rect(c: [f64; 2], r: f64, x0: f64, x1: f64, y0: f64, y1: f64) -> f64
     if inside(ax, ay) && inside(ax, by) && inside(bx, ay) && inside(bx, by) {
         return (x1 - x0) * (y1 - y0);
     }
-    if ax >= r || bx <= -r || ay >= r || by <= -r {
+    // Nearest point of the rectangle to the centre outside the disk: no overlap.
+    let (nx, ny) = (ax.max(0.0).min(bx), ay.max(0.0).min(by));
+    if nx * nx + ny * ny >= r * r {
         return 0.0;
     }
     let a = quadrant(bx, by, r) - quadrant(ax, by, r) - quadrant(bx, ay, r) + quadrant(ax, ay, r);

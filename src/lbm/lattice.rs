@@ -520,36 +520,67 @@ impl<T: Real> Lattice<T> {
                     )
                 };
             }
-            // Covered nodes.
-            for k in k0..k1 {
-                let c = psm.cells[k] as usize;
-                if solid[c] {
-                    continue;
+            // Covered nodes, collided LANES at a time.
+            let mut k = k0;
+            while k < k1 {
+                let mut sps: [Special; LANES] = std::array::from_fn(|_| Special {
+                    cell: 0,
+                    nb: [Neighbour::Open; Q],
+                    zou_he: None,
+                });
+                let mut idx = [0usize; LANES];
+                let mut len = 0;
+                while k < k1 && len < LANES {
+                    let c = psm.cells[k] as usize;
+                    if !solid[c] {
+                        let s = special_of[c];
+                        sps[len] = if s != u32::MAX {
+                            specials[s as usize].clone()
+                        } else {
+                            // A bulk node: its eight neighbours are fluid, x ± 1 in the row.
+                            let x = c % nx;
+                            Special {
+                                cell: c as u32,
+                                nb: std::array::from_fn(|i| {
+                                    let yy =
+                                        (y as i64 + CY[i] as i64).rem_euclid(ny as i64) as usize;
+                                    Neighbour::Fluid(
+                                        (yy * nx + (x as i64 + CX[i] as i64) as usize) as u32,
+                                    )
+                                }),
+                                zou_he: None,
+                            }
+                        };
+                        idx[len] = k;
+                        len += 1;
+                    }
+                    k += 1;
                 }
-                let s = special_of[c];
-                let bulk_node;
-                let sp = if s != u32::MAX {
-                    &specials[s as usize]
-                } else {
-                    // A bulk node: its eight neighbours are fluid and inside the row range.
-                    let x = c % nx;
-                    bulk_node = Special {
-                        cell: c as u32,
-                        nb: std::array::from_fn(|i| {
-                            let yy = (y as i64 + CY[i] as i64).rem_euclid(ny as i64) as usize;
-                            Neighbour::Fluid((yy * nx + (x as i64 + CX[i] as i64) as usize) as u32)
-                        }),
-                        zou_he: None,
-                    };
-                    &bulk_node
-                };
-                // SAFETY: as in `step`; entry k of `exchange` belongs to this row only.
-                unsafe {
-                    let (g, _) = gather(base.get(), n, sp, even, wall_corr, zh_shift);
-                    let (post, dp) =
-                        partial::collide(&g, psm.b[k], [psm.ux[k], psm.uy[k]], collider);
-                    scatter(base.get(), n, sp, &post, even, wall_corr);
-                    *exchange.get().add(k) = dp;
+                let mut g = [[T::zero(); LANES]; Q];
+                let (mut b, mut us) = ([T::zero(); LANES], [[T::zero(); LANES]; 2]);
+                for l in 0..LANES {
+                    // Lanes past `len` repeat lane 0 (computed, never written back).
+                    let (sp, kk) = if l < len { (&sps[l], idx[l]) } else { (&sps[0], idx[0]) };
+                    // SAFETY: as in `step` (reads only).
+                    let (gl, _) =
+                        unsafe { gather(base.get(), n, sp, even, wall_corr, zh_shift) };
+                    for i in 0..Q {
+                        g[i][l] = gl[i];
+                    }
+                    b[l] = psm.b[kk];
+                    us[0][l] = psm.ux[kk];
+                    us[1][l] = psm.uy[kk];
+                }
+                let mut post = g;
+                collider.collide(&mut post);
+                let dp = partial::blend(&g, &mut post, &b, &us, collider.force);
+                for l in 0..len {
+                    let out: [T; Q] = std::array::from_fn(|i| post[i][l]);
+                    // SAFETY: as in `step`; entry idx[l] of `exchange` belongs to this row.
+                    unsafe {
+                        scatter(base.get(), n, &sps[l], &out, even, wall_corr);
+                        *exchange.get().add(idx[l]) = [dp[0][l].f64(), dp[1][l].f64()];
+                    }
                 }
             }
         });

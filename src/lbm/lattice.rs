@@ -556,14 +556,20 @@ impl<T: Real> Lattice<T> {
                     }
                     k += 1;
                 }
+                if len == 0 {
+                    continue;
+                }
                 let mut g = [[T::zero(); LANES]; Q];
                 let (mut b, mut us) = ([T::zero(); LANES], [[T::zero(); LANES]; 2]);
                 for l in 0..LANES {
                     // Lanes past `len` repeat lane 0 (computed, never written back).
-                    let (sp, kk) = if l < len { (&sps[l], idx[l]) } else { (&sps[0], idx[0]) };
+                    let (sp, kk) = if l < len {
+                        (&sps[l], idx[l])
+                    } else {
+                        (&sps[0], idx[0])
+                    };
                     // SAFETY: as in `step` (reads only).
-                    let (gl, _) =
-                        unsafe { gather(base.get(), n, sp, even, wall_corr, zh_shift) };
+                    let (gl, _) = unsafe { gather(base.get(), n, sp, even, wall_corr, zh_shift) };
                     for i in 0..Q {
                         g[i][l] = gl[i];
                     }

@@ -207,7 +207,10 @@ pub fn blend<T: Real, const L: usize>(
         let inv = one / rho;
         let (ux, uy) = ((jx + half * fx) * inv, (jy + half * fy) * inv);
         let (sx, sy) = (us[0][l], us[1][l]);
-        let (bu, bs) = (one - c15 * (ux * ux + uy * uy), one - c15 * (sx * sx + sy * sy));
+        let (bu, bs) = (
+            one - c15 * (ux * ux + uy * uy),
+            one - c15 * (sx * sx + sy * sy),
+        );
         let feq = |i: usize, vx: T, vy: T, base: T| {
             let cu = T::c(CX[i] as f64) * vx + T::c(CY[i] as f64) * vy;
             w[i] * rho * (base + three * cu + c45 * cu * cu)

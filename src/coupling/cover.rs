@@ -14,10 +14,15 @@
 //! Periodic lattice edges wrap the cells a disk covers; on other edges cells outside the
 //! lattice are dropped. Lattice cell (i, j) spans [iΔx, (i+1)Δx] × [jΔx, (j+1)Δx].
 
+use rayon::prelude::*;
+
 use super::overlap::disk_rect;
 use crate::dem::scale::GrainView;
 use crate::dem::ExternalLoads;
 use crate::lbm::{CellForces, SolidCover};
+
+/// Grains per parallel chunk of the rasterisation.
+const GRAIN_CHUNK: usize = 64;
 
 /// The lattice the disks are drawn on.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,7 +57,8 @@ pub struct DiskCover {
     pub grid: Grid,
     /// Hydrodynamic radius factor κ = r/R ∈ (0, 1].
     pub radius_factor: f64,
-    pieces: Vec<Piece>,
+    /// Overlaps of each chunk of [`GRAIN_CHUNK`] grains.
+    pieces: Vec<Vec<Piece>>,
     /// Σ_k ε_nk, Σ_k ε_nk u_x, Σ_k ε_nk u_y per cell (dense; zero outside the cover).
     acc: Vec<[f64; 3]>,
     /// Cover slot of each cell (dense; valid for covered cells).
@@ -95,44 +101,58 @@ impl DiskCover {
             dx,
             periodic,
         } = self.grid;
-        self.pieces.clear();
         self.touched.clear();
         self.grains = g.x.len();
-        for k in 0..g.x.len() {
-            let r = self.radius_factor * g.radius[k] / dx;
-            let (cx, cy) = (g.x[k] / dx, g.y[k] / dx);
-            let (i0, i1) = ((cx - r).floor() as i64, (cx + r).floor() as i64);
-            let (j0, j1) = ((cy - r).floor() as i64, (cy + r).floor() as i64);
-            let w = g.omega[k];
-            for j in j0..=j1 {
-                let Some(jj) = wrap(j, ny, periodic[1]) else {
-                    continue;
-                };
-                for i in i0..=i1 {
-                    let Some(ii) = wrap(i, nx, periodic[0]) else {
-                        continue;
-                    };
-                    let (x, y) = (i as f64, j as f64);
-                    let eps = disk_rect([cx, cy], r, x, x + 1.0, y, y + 1.0);
-                    if eps > 0.0 {
-                        let cell = jj * nx + ii;
-                        let rr = [(x + 0.5 - cx) * dx, (y + 0.5 - cy) * dx];
-                        let a = &mut self.acc[cell];
-                        if a[0] == 0.0 {
-                            self.touched.push(cell as u32);
+        // Overlaps in parallel over chunks of grains (one reused buffer per chunk), then summed
+        // per cell in one serial pass (grains may share cells).
+        let chunks = g.x.len().div_ceil(GRAIN_CHUNK);
+        if self.pieces.len() < chunks {
+            self.pieces.resize_with(chunks, Vec::new);
+        }
+        let kappa = self.radius_factor;
+        self.pieces[..chunks]
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(ch, buf)| {
+                buf.clear();
+                let k1 = ((ch + 1) * GRAIN_CHUNK).min(g.x.len());
+                for k in ch * GRAIN_CHUNK..k1 {
+                    let r = kappa * g.radius[k] / dx;
+                    let (cx, cy) = (g.x[k] / dx, g.y[k] / dx);
+                    let (i0, i1) = ((cx - r).floor() as i64, (cx + r).floor() as i64);
+                    let (j0, j1) = ((cy - r).floor() as i64, (cy + r).floor() as i64);
+                    for j in j0..=j1 {
+                        let Some(jj) = wrap(j, ny, periodic[1]) else {
+                            continue;
+                        };
+                        for i in i0..=i1 {
+                            let Some(ii) = wrap(i, nx, periodic[0]) else {
+                                continue;
+                            };
+                            let (x, y) = (i as f64, j as f64);
+                            let eps = disk_rect([cx, cy], r, x, x + 1.0, y, y + 1.0);
+                            if eps > 0.0 {
+                                buf.push(Piece {
+                                    cell: (jj * nx + ii) as u32,
+                                    grain: k as u32,
+                                    eps,
+                                    r: [(x + 0.5 - cx) * dx, (y + 0.5 - cy) * dx],
+                                });
+                            }
                         }
-                        a[0] += eps;
-                        a[1] += eps * (g.vx[k] - w * rr[1]);
-                        a[2] += eps * (g.vy[k] + w * rr[0]);
-                        self.pieces.push(Piece {
-                            cell: cell as u32,
-                            grain: k as u32,
-                            eps,
-                            r: rr,
-                        });
                     }
                 }
+            });
+        for p in self.pieces[..chunks].iter().flatten() {
+            let k = p.grain as usize;
+            let w = g.omega[k];
+            let a = &mut self.acc[p.cell as usize];
+            if a[0] == 0.0 {
+                self.touched.push(p.cell);
             }
+            a[0] += p.eps;
+            a[1] += p.eps * (g.vx[k] - w * p.r[1]);
+            a[2] += p.eps * (g.vy[k] + w * p.r[0]);
         }
         out.cells.clear();
         out.eps.clear();
@@ -178,7 +198,8 @@ impl DiskCover {
             // The fluid has not stepped with this cover yet: no force.
             return;
         }
-        for p in &self.pieces {
+        let chunks = self.grains.div_ceil(GRAIN_CHUNK);
+        for p in self.pieces[..chunks].iter().flatten() {
             let s = self.slot_of[p.cell as usize] as usize;
             let share = p.eps / self.total[s];
             let (fx, fy) = (share * forces.fx[s], share * forces.fy[s]);

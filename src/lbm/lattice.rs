@@ -585,7 +585,7 @@ impl<T: Real> Lattice<T> {
                     // SAFETY: as in `step`; entry idx[l] of `exchange` belongs to this row.
                     unsafe {
                         scatter(base.get(), n, &sps[l], &out, even, wall_corr);
-                        *exchange.get().add(idx[l]) = [dp[0][l].f64(), dp[1][l].f64()];
+                        *exchange.get().add(idx[l]) = [dp[0][l], dp[1][l]];
                     }
                 }
             }

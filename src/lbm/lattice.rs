@@ -520,7 +520,61 @@ impl<T: Real> Lattice<T> {
                     )
                 };
             }
-            // Covered nodes, collided LANES at a time.
+            // Covered bulk nodes: stretches of consecutive cells take the vector path with
+            // the partially saturated blend.
+            let mut k = k0;
+            while k < k1 {
+                let c = psm.cells[k] as usize;
+                if solid[c] || special_of[c] != u32::MAX {
+                    k += 1;
+                    continue;
+                }
+                let mut e = k + 1;
+                while e < k1 {
+                    let ce = psm.cells[e] as usize;
+                    if ce != c + (e - k) || solid[ce] || special_of[ce] != u32::MAX {
+                        break;
+                    }
+                    e += 1;
+                }
+                let x0 = c - y * nx;
+                // SAFETY: as in `step`; entries k..e of `exchange` belong to this row.
+                unsafe {
+                    if bulk_lanes::<T>() == 32 {
+                        bulk_run_psm::<T, 32>(
+                            base.get(),
+                            n,
+                            nx,
+                            ny,
+                            y,
+                            x0,
+                            x0 + e - k,
+                            even,
+                            collider,
+                            psm,
+                            k,
+                            exchange.get(),
+                        )
+                    } else {
+                        bulk_run_psm::<T, 16>(
+                            base.get(),
+                            n,
+                            nx,
+                            ny,
+                            y,
+                            x0,
+                            x0 + e - k,
+                            even,
+                            collider,
+                            psm,
+                            k,
+                            exchange.get(),
+                        )
+                    }
+                }
+                k = e;
+            }
+            // Covered special nodes, collided LANES at a time.
             let mut k = k0;
             while k < k1 {
                 let mut sps: [Special; LANES] = std::array::from_fn(|_| Special {
@@ -532,7 +586,7 @@ impl<T: Real> Lattice<T> {
                 let mut len = 0;
                 while k < k1 && len < LANES {
                     let c = psm.cells[k] as usize;
-                    if !solid[c] {
+                    if !solid[c] && special_of[c] != u32::MAX {
                         let s = special_of[c];
                         sps[len] = if s != u32::MAX {
                             specials[s as usize].clone()
@@ -718,6 +772,70 @@ unsafe fn bulk_run<T: Real, const L: usize>(
             let slot = if even { OPP[i] } else { i };
             std::ptr::copy_nonoverlapping(buf[i].as_ptr(), f.add(offs[slot] + x), len);
         }
+    }
+}
+
+/// Collide a stretch `x0..x1` of covered bulk nodes of row `y` (the cells of `psm` from entry
+/// `k0` on) as in [`bulk_run`], with the partially saturated blend of [`partial::blend`], and
+/// store the exchanged momentum at `exchange[k0..]`.
+///
+/// # Safety
+/// As [`bulk_run`]; entries `k0..k0 + x1 − x0` of `exchange` belong to this call.
+#[allow(clippy::too_many_arguments)]
+unsafe fn bulk_run_psm<T: Real, const L: usize>(
+    f: *mut T,
+    n: usize,
+    nx: usize,
+    ny: usize,
+    y: usize,
+    x0: usize,
+    x1: usize,
+    even: bool,
+    collider: &Collider<T>,
+    psm: &PartialCells<T>,
+    k0: usize,
+    exchange: *mut [f64; 2],
+) {
+    let row = y * nx;
+    let offs: [usize; Q] = std::array::from_fn(|i| {
+        if even {
+            i * n + row
+        } else {
+            let yy = (y as i64 + CY[i] as i64).rem_euclid(ny as i64) as usize;
+            ((i * n + yy * nx) as i64 + CX[i] as i64) as usize
+        }
+    });
+    let mut x = x0;
+    while x < x1 {
+        let len = (x1 - x).min(L);
+        let o = k0 + (x - x0);
+        let mut buf = [[T::zero(); L]; Q];
+        for i in 0..Q {
+            let dst = if even { i } else { OPP[i] };
+            std::ptr::copy_nonoverlapping(f.add(offs[i] + x), buf[dst].as_mut_ptr(), len);
+            for l in len..L {
+                buf[dst][l] = buf[dst][0];
+            }
+        }
+        let g = buf;
+        collider.collide(&mut buf);
+        // Padding lanes get B = 0 (plain collision; never written back).
+        let mut b = [T::zero(); L];
+        let mut us = [[T::zero(); L]; 2];
+        for l in 0..len {
+            b[l] = psm.b[o + l];
+            us[0][l] = psm.ux[o + l];
+            us[1][l] = psm.uy[o + l];
+        }
+        let dp = partial::blend(&g, &mut buf, &b, &us, collider.force);
+        for i in 0..Q {
+            let slot = if even { OPP[i] } else { i };
+            std::ptr::copy_nonoverlapping(buf[i].as_ptr(), f.add(offs[slot] + x), len);
+        }
+        for (l, (px, py)) in dp[0].iter().zip(&dp[1]).take(len).enumerate() {
+            *exchange.add(o + l) = [*px, *py];
+        }
+        x += len;
     }
 }
 

@@ -200,33 +200,45 @@ pub fn blend<T: Real, const L: usize>(
     force: [f64; 2],
 ) -> [[f64; L]; 2] {
     let [fx, fy] = force;
-    let mut dp = [[0.0; L]; 2];
-    for l in 0..L {
-        let f: [f64; Q] = std::array::from_fn(|i| g[i][l].f64());
-        let rho: f64 = f.iter().sum();
-        let jx = f[1] - f[3] + f[5] - f[6] - f[7] + f[8];
-        let jy = f[2] - f[4] + f[5] + f[6] - f[7] - f[8];
-        let (ux, uy) = ((jx + 0.5 * fx) / rho, (jy + 0.5 * fy) / rho);
-        let (sx, sy) = (us[0][l].f64(), us[1][l].f64());
-        let (bu, bs) = (
-            1.0 - 1.5 * (ux * ux + uy * uy),
-            1.0 - 1.5 * (sx * sx + sy * sy),
-        );
-        let feq = |i: usize, vx: f64, vy: f64, base: f64| {
-            let cu = CX[i] as f64 * vx + CY[i] as f64 * vy;
-            super::d2q9::W[i] * rho * (base + 3.0 * cu + 4.5 * cu * cu)
-        };
-        let bl = b[l].f64();
-        let (mut px, mut py) = (0.0, 0.0);
-        for i in 0..Q {
-            let o = OPP[i];
-            let omega_s = (f[o] - feq(o, ux, uy, bu)) - (f[i] - feq(i, sx, sy, bs));
-            post[i][l] = T::c((1.0 - bl) * post[i][l].f64() + bl * (f[i] + omega_s));
-            px += omega_s * CX[i] as f64;
-            py += omega_s * CY[i] as f64;
+    // Lane loops innermost, so they vectorise.
+    let mut f = [[0.0f64; L]; Q];
+    for i in 0..Q {
+        for l in 0..L {
+            f[i][l] = g[i][l].f64();
         }
-        dp[0][l] = bl * px;
-        dp[1][l] = bl * py;
+    }
+    let (mut ux, mut uy, mut rho) = ([0.0; L], [0.0; L], [0.0; L]);
+    let (mut bu, mut bs, mut bl) = ([0.0; L], [0.0; L], [0.0; L]);
+    let (mut sx, mut sy) = ([0.0; L], [0.0; L]);
+    for l in 0..L {
+        let r =
+            f[0][l] + f[1][l] + f[2][l] + f[3][l] + f[4][l] + f[5][l] + f[6][l] + f[7][l] + f[8][l];
+        let jx = f[1][l] - f[3][l] + f[5][l] - f[6][l] - f[7][l] + f[8][l];
+        let jy = f[2][l] - f[4][l] + f[5][l] + f[6][l] - f[7][l] - f[8][l];
+        rho[l] = r;
+        ux[l] = (jx + 0.5 * fx) / r;
+        uy[l] = (jy + 0.5 * fy) / r;
+        sx[l] = us[0][l].f64();
+        sy[l] = us[1][l].f64();
+        bu[l] = 1.0 - 1.5 * (ux[l] * ux[l] + uy[l] * uy[l]);
+        bs[l] = 1.0 - 1.5 * (sx[l] * sx[l] + sy[l] * sy[l]);
+        bl[l] = b[l].f64();
+    }
+    let mut dp = [[0.0; L]; 2];
+    for i in 0..Q {
+        let o = OPP[i];
+        let (cx, cy, w) = (CX[i] as f64, CY[i] as f64, super::d2q9::W[i]);
+        for l in 0..L {
+            // f_ī^eq(ρ, u) uses e_ī = −e_i; f_i^eq(ρ, u_s).
+            let cu = cx * ux[l] + cy * uy[l];
+            let cs = cx * sx[l] + cy * sy[l];
+            let feq_o = w * rho[l] * (bu[l] - 3.0 * cu + 4.5 * cu * cu);
+            let feq_s = w * rho[l] * (bs[l] + 3.0 * cs + 4.5 * cs * cs);
+            let omega_s = (f[o][l] - feq_o) - (f[i][l] - feq_s);
+            post[i][l] = T::c((1.0 - bl[l]) * post[i][l].f64() + bl[l] * (f[i][l] + omega_s));
+            dp[0][l] += bl[l] * omega_s * cx;
+            dp[1][l] += bl[l] * omega_s * cy;
+        }
     }
     dp
 }

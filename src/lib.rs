@@ -33,6 +33,7 @@
 pub mod analysis;
 pub mod bench;
 pub mod config;
+pub mod coupling;
 pub mod dem;
 pub mod error;
 pub mod io;

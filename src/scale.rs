@@ -22,6 +22,10 @@ pub trait Scale {
     fn max_dt(&self) -> f64;
     /// Advance by `dt` seconds with `input` held fixed; a scale may sub-step internally.
     fn advance(&mut self, input: &Self::Input, dt: f64) -> Result<()>;
+    /// Told by a driver that the input changed since the last `advance` (e.g. new
+    /// hydrodynamic loads): a scale that carries input-dependent state between steps (the
+    /// DEM's end-of-step forces for its first half-kick) refreshes it. Default: nothing.
+    fn input_changed(&mut self) {}
     /// Write what the other scales need into `out`.
     fn observe(&self, out: &mut Self::Output);
     /// Copy the state.

@@ -42,6 +42,12 @@ impl Scale for Dem {
         self.advance_with(dt, Some(input))
     }
 
+    /// New external loads: the forces of the last step (used by the next half-kick) are
+    /// re-evaluated with them, so a load held over Δt gives exactly the impulse F Δt.
+    fn input_changed(&mut self) {
+        self.invalidate_forces();
+    }
+
     fn observe(&self, out: &mut GrainView) {
         let g = &self.grains;
         out.x.clone_from(&g.x);

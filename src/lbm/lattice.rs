@@ -22,6 +22,7 @@ use rayon::prelude::*;
 use super::boundary::{zou_he, Edge, Edges, Neighbour, ZouHe, ZouHeNode};
 use super::collision::Collider;
 use super::d2q9::{equilibrium, CX, CY, OPP, Q, W};
+use super::partial::{self, PartialCells};
 use super::real::Real;
 
 /// Nodes collided together as the lanes of one vector in the special-node path.
@@ -425,6 +426,227 @@ impl<T: Real> Lattice<T> {
         self.even = !even;
     }
 
+    /// One fused stream–collide step in which the cells of `psm` collide as partially
+    /// saturated cells ([`super::partial`]) and record the momentum exchanged with the solid in
+    /// `psm.exchange`. Streaming is unchanged: a covered cell streams like the fluid node it is.
+    /// With no covered cells this is [`Lattice::step`].
+    pub fn step_partial(&mut self, collider: &Collider<T>, psm: &mut PartialCells<T>) {
+        if psm.is_empty() {
+            return self.step(collider);
+        }
+        psm.index_rows(self.nx, self.ny);
+        let (nx, ny, n, even) = (self.nx, self.ny, self.stride, self.even);
+        self.zh_shift = [0.5 * collider.force[0], 0.5 * collider.force[1]];
+        let zh_shift = self.zh_shift;
+        let base = Shared(self.f.as_mut_ptr());
+        let exchange = Shared(psm.exchange.as_mut_ptr());
+        let (specials, special_of, solid) = (&self.specials, &self.special_of, &self.solid);
+        let wall_corr = &self.wall_corr;
+        let psm = &*psm;
+        self.rows.par_iter().enumerate().for_each(|(y, plan)| {
+            let (runs, group_list) = if even {
+                (&plan.even_runs, &plan.even_specials)
+            } else {
+                (&plan.runs, &plan.specials)
+            };
+            let (k0, k1) = (psm.row_start[y] as usize, psm.row_start[y + 1] as usize);
+            let covered = &psm.cells[k0..k1];
+            let is_covered = |c: u32| covered.binary_search(&c).is_ok();
+            let row = (y * nx) as u32;
+            let bulk = |x0: usize, x1: usize| {
+                // SAFETY: as in `step`.
+                unsafe {
+                    if bulk_lanes::<T>() == 32 {
+                        bulk_run::<T, 32>(base.get(), n, nx, ny, y, x0, x1, even, collider)
+                    } else {
+                        bulk_run::<T, 16>(base.get(), n, nx, ny, y, x0, x1, even, collider)
+                    }
+                }
+            };
+            // Bulk runs, cut around the covered cells.
+            for &(x0, x1) in runs {
+                let mut start = x0;
+                for &c in covered {
+                    let x = c - row;
+                    if x >= x0 && x < x1 {
+                        if x > start {
+                            bulk(start as usize, x as usize);
+                        }
+                        start = x + 1;
+                    }
+                }
+                if start < x1 {
+                    bulk(start as usize, x1 as usize);
+                }
+            }
+            // Special nodes that are not covered, in groups of LANES.
+            let mut group = [0u32; LANES];
+            let mut len = 0;
+            for &s in group_list {
+                if is_covered(specials[s as usize].cell) {
+                    continue;
+                }
+                group[len] = s;
+                len += 1;
+                if len == LANES {
+                    // SAFETY: as in `step`.
+                    unsafe {
+                        special_nodes(
+                            base.get(),
+                            n,
+                            specials,
+                            &group,
+                            even,
+                            collider,
+                            wall_corr,
+                            zh_shift,
+                        )
+                    };
+                    len = 0;
+                }
+            }
+            if len > 0 {
+                // SAFETY: as in `step`.
+                unsafe {
+                    special_nodes(
+                        base.get(),
+                        n,
+                        specials,
+                        &group[..len],
+                        even,
+                        collider,
+                        wall_corr,
+                        zh_shift,
+                    )
+                };
+            }
+            // Covered bulk nodes: stretches of consecutive cells take the vector path with
+            // the partially saturated blend.
+            let mut k = k0;
+            while k < k1 {
+                let c = psm.cells[k] as usize;
+                if solid[c] || special_of[c] != u32::MAX {
+                    k += 1;
+                    continue;
+                }
+                let mut e = k + 1;
+                while e < k1 {
+                    let ce = psm.cells[e] as usize;
+                    if ce != c + (e - k) || solid[ce] || special_of[ce] != u32::MAX {
+                        break;
+                    }
+                    e += 1;
+                }
+                let x0 = c - y * nx;
+                // SAFETY: as in `step`; entries k..e of `exchange` belong to this row.
+                unsafe {
+                    if bulk_lanes::<T>() == 32 {
+                        bulk_run_psm::<T, 32>(
+                            base.get(),
+                            n,
+                            nx,
+                            ny,
+                            y,
+                            x0,
+                            x0 + e - k,
+                            even,
+                            collider,
+                            psm,
+                            k,
+                            exchange.get(),
+                        )
+                    } else {
+                        bulk_run_psm::<T, 16>(
+                            base.get(),
+                            n,
+                            nx,
+                            ny,
+                            y,
+                            x0,
+                            x0 + e - k,
+                            even,
+                            collider,
+                            psm,
+                            k,
+                            exchange.get(),
+                        )
+                    }
+                }
+                k = e;
+            }
+            // Covered special nodes, collided LANES at a time.
+            let mut k = k0;
+            while k < k1 {
+                let mut sps: [Special; LANES] = std::array::from_fn(|_| Special {
+                    cell: 0,
+                    nb: [Neighbour::Open; Q],
+                    zou_he: None,
+                });
+                let mut idx = [0usize; LANES];
+                let mut len = 0;
+                while k < k1 && len < LANES {
+                    let c = psm.cells[k] as usize;
+                    if !solid[c] && special_of[c] != u32::MAX {
+                        let s = special_of[c];
+                        sps[len] = if s != u32::MAX {
+                            specials[s as usize].clone()
+                        } else {
+                            // A bulk node: its eight neighbours are fluid, x ± 1 in the row.
+                            let x = c % nx;
+                            Special {
+                                cell: c as u32,
+                                nb: std::array::from_fn(|i| {
+                                    let yy =
+                                        (y as i64 + CY[i] as i64).rem_euclid(ny as i64) as usize;
+                                    Neighbour::Fluid(
+                                        (yy * nx + (x as i64 + CX[i] as i64) as usize) as u32,
+                                    )
+                                }),
+                                zou_he: None,
+                            }
+                        };
+                        idx[len] = k;
+                        len += 1;
+                    }
+                    k += 1;
+                }
+                if len == 0 {
+                    continue;
+                }
+                let mut g = [[T::zero(); LANES]; Q];
+                let (mut b, mut us) = ([T::zero(); LANES], [[T::zero(); LANES]; 2]);
+                for l in 0..LANES {
+                    // Lanes past `len` repeat lane 0 (computed, never written back).
+                    let (sp, kk) = if l < len {
+                        (&sps[l], idx[l])
+                    } else {
+                        (&sps[0], idx[0])
+                    };
+                    // SAFETY: as in `step` (reads only).
+                    let (gl, _) = unsafe { gather(base.get(), n, sp, even, wall_corr, zh_shift) };
+                    for i in 0..Q {
+                        g[i][l] = gl[i];
+                    }
+                    b[l] = psm.b[kk];
+                    us[0][l] = psm.ux[kk];
+                    us[1][l] = psm.uy[kk];
+                }
+                let mut post = g;
+                collider.collide(&mut post);
+                let dp = partial::blend(&g, &mut post, &b, &us, collider.force);
+                for l in 0..len {
+                    let out: [T; Q] = std::array::from_fn(|i| post[i][l]);
+                    // SAFETY: as in `step`; entry idx[l] of `exchange` belongs to this row.
+                    unsafe {
+                        scatter(base.get(), n, &sps[l], &out, even, wall_corr);
+                        *exchange.get().add(idx[l]) = [dp[0][l], dp[1][l]];
+                    }
+                }
+            }
+        });
+        self.even = !even;
+    }
+
     /// Pre-collision populations of fluid cell `c` at the current time (after streaming and
     /// boundary closure): what the next step will collide.
     /// A solid cell has no populations: it reports the rest state at unit density.
@@ -553,6 +775,70 @@ unsafe fn bulk_run<T: Real, const L: usize>(
     }
 }
 
+/// Collide a stretch `x0..x1` of covered bulk nodes of row `y` (the cells of `psm` from entry
+/// `k0` on) as in [`bulk_run`], with the partially saturated blend of [`partial::blend`], and
+/// store the exchanged momentum at `exchange[k0..]`.
+///
+/// # Safety
+/// As [`bulk_run`]; entries `k0..k0 + x1 − x0` of `exchange` belong to this call.
+#[allow(clippy::too_many_arguments)]
+unsafe fn bulk_run_psm<T: Real, const L: usize>(
+    f: *mut T,
+    n: usize,
+    nx: usize,
+    ny: usize,
+    y: usize,
+    x0: usize,
+    x1: usize,
+    even: bool,
+    collider: &Collider<T>,
+    psm: &PartialCells<T>,
+    k0: usize,
+    exchange: *mut [f64; 2],
+) {
+    let row = y * nx;
+    let offs: [usize; Q] = std::array::from_fn(|i| {
+        if even {
+            i * n + row
+        } else {
+            let yy = (y as i64 + CY[i] as i64).rem_euclid(ny as i64) as usize;
+            ((i * n + yy * nx) as i64 + CX[i] as i64) as usize
+        }
+    });
+    let mut x = x0;
+    while x < x1 {
+        let len = (x1 - x).min(L);
+        let o = k0 + (x - x0);
+        let mut buf = [[T::zero(); L]; Q];
+        for i in 0..Q {
+            let dst = if even { i } else { OPP[i] };
+            std::ptr::copy_nonoverlapping(f.add(offs[i] + x), buf[dst].as_mut_ptr(), len);
+            for l in len..L {
+                buf[dst][l] = buf[dst][0];
+            }
+        }
+        let g = buf;
+        collider.collide(&mut buf);
+        // Padding lanes get B = 0 (plain collision; never written back).
+        let mut b = [T::zero(); L];
+        let mut us = [[T::zero(); L]; 2];
+        for l in 0..len {
+            b[l] = psm.b[o + l];
+            us[0][l] = psm.ux[o + l];
+            us[1][l] = psm.uy[o + l];
+        }
+        let dp = partial::blend(&g, &mut buf, &b, &us, collider.force);
+        for i in 0..Q {
+            let slot = if even { OPP[i] } else { i };
+            std::ptr::copy_nonoverlapping(buf[i].as_ptr(), f.add(offs[slot] + x), len);
+        }
+        for (l, (px, py)) in dp[0].iter().zip(&dp[1]).take(len).enumerate() {
+            *exchange.add(o + l) = [*px, *py];
+        }
+        x += len;
+    }
+}
+
 /// Gather the pre-collision populations of a special node and the mask of unknown ones, and
 /// apply the Zou–He closure.
 ///
@@ -642,6 +928,34 @@ unsafe fn special_nodes<T: Real>(
                     Neighbour::Bounce(w) => *f.add(OPP[i] * n + c) = v - wall_corr[w as usize][i],
                     Neighbour::Open => {}
                 }
+            }
+        }
+    }
+}
+
+/// Write the post-collision populations of one special node (the scatter of
+/// [`special_nodes`]).
+///
+/// # Safety
+/// As [`special_nodes`].
+unsafe fn scatter<T: Real>(
+    f: *mut T,
+    n: usize,
+    sp: &Special,
+    post: &[T; Q],
+    even: bool,
+    wall_corr: &[[T; Q]],
+) {
+    let c = sp.cell as usize;
+    for i in 0..Q {
+        let v = post[i];
+        if even {
+            *f.add(OPP[i] * n + c) = v;
+        } else {
+            match sp.nb[i] {
+                Neighbour::Fluid(k) => *f.add(i * n + k as usize) = v,
+                Neighbour::Bounce(w) => *f.add(OPP[i] * n + c) = v - wall_corr[w as usize][i],
+                Neighbour::Open => {}
             }
         }
     }

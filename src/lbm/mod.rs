@@ -5,6 +5,7 @@
 //! * [`lattice`]: population storage (structure of arrays) and the in-place AA stream–collide.
 //! * [`boundary`]: periodic, half-way bounce-back (resting or moving), Zou–He edges.
 //! * [`obstacle`]: shapes, interpolated bounce-back, momentum-exchange forces.
+//! * [`partial`]: partially saturated cells (Noble–Torczynski) for moving solids.
 //! * [`solver`]: the solver in time, its [`Scale`](crate::scale::Scale) implementation.
 
 pub mod boundary;
@@ -12,6 +13,7 @@ pub mod collision;
 pub mod d2q9;
 pub mod lattice;
 pub mod obstacle;
+pub mod partial;
 pub mod real;
 pub mod solver;
 
@@ -19,5 +21,6 @@ pub use boundary::{Edge, Edges};
 pub use collision::{Collider, CollisionModel, MrtRates};
 pub use lattice::Lattice;
 pub use obstacle::{Obstacle, Obstacles, Shape};
+pub use partial::{CellForces, PartialCells, SolidCover};
 pub use real::Real;
 pub use solver::{Fluid, Lbm, Macroscopic};

@@ -5,6 +5,7 @@ use super::collision::Collider;
 use super::d2q9::{CX, CY, Q};
 use super::lattice::Lattice;
 use super::obstacle::Obstacles;
+use super::partial::{self, CellForces, PartialCells, SolidCover};
 use super::real::Real;
 use crate::scale::Scale;
 use crate::units::{Units, CS2};
@@ -71,6 +72,11 @@ pub struct Lbm<T> {
     pub units: Units,
     /// Steps taken.
     pub steps: u64,
+    /// Cells partially covered by moving solids (empty: a plain fluid).
+    pub partial: PartialCells<T>,
+    /// Momentum exchanged per covered cell summed over the steps of the last
+    /// [`Scale::advance`], and their number.
+    exchange_sum: (Vec<[f64; 2]>, u64),
 }
 
 impl<T: Real> Lbm<T> {
@@ -89,13 +95,19 @@ impl<T: Real> Lbm<T> {
             obstacles,
             units,
             steps: 0,
+            partial: PartialCells::new(),
+            exchange_sum: (Vec::new(), 0),
         }
     }
 
-    /// One lattice step.
+    /// One lattice step; cells in [`Lbm::partial`] collide as partially saturated cells.
     pub fn step(&mut self) {
         let was_even = self.lattice.next_is_even();
-        self.lattice.step(&self.collider);
+        if self.partial.is_empty() {
+            self.lattice.step(&self.collider);
+        } else {
+            self.lattice.step_partial(&self.collider, &mut self.partial);
+        }
         self.obstacles.after_step(&mut self.lattice, was_even);
         self.steps += 1;
     }
@@ -112,6 +124,45 @@ impl<T: Real> Lbm<T> {
         }
         let [fx, fy] = self.collider.force;
         (r, (jx + 0.5 * fx) / r, (jy + 0.5 * fy) / r)
+    }
+
+    /// Set the covered cells from a solid cover in SI: B = B(ε, τ) of
+    /// [`partial::weighting`] with the molecular τ, velocities converted to lattice units.
+    /// Cells must be ascending.
+    pub fn set_cover(&mut self, cover: &SolidCover) {
+        let p = &mut self.partial;
+        p.clear();
+        let tau = self.collider.tau;
+        for k in 0..cover.cells.len() {
+            p.push(
+                cover.cells[k],
+                partial::weighting(cover.eps[k], tau),
+                [
+                    self.units.velocity_to_lattice(cover.ux[k]),
+                    self.units.velocity_to_lattice(cover.uy[k]),
+                ],
+            );
+        }
+    }
+
+    /// Total fluid momentum Σ_cells Σ_i f_i e_i (lattice units, pre-collision, without the
+    /// half-force shift), accumulated in f64.
+    pub fn momentum(&self) -> [f64; 2] {
+        use rayon::prelude::*;
+        let lat = &self.lattice;
+        (0..lat.len())
+            .into_par_iter()
+            .filter(|&c| !lat.is_solid(c))
+            .map(|c| {
+                let f = lat.populations(c);
+                let mut j = [0.0; 2];
+                for i in 0..Q {
+                    j[0] += f[i].f64() * CX[i] as f64;
+                    j[1] += f[i].f64() * CY[i] as f64;
+                }
+                j
+            })
+            .reduce(|| [0.0; 2], |a, b| [a[0] + b[0], a[1] + b[1]])
     }
 
     /// Fill `m` with the macroscopic fields.
@@ -244,9 +295,10 @@ pub struct LbmSnapshot<T> {
 }
 
 impl<T: Real> Scale for Lbm<T> {
-    /// The fluid takes no input yet (solid fractions arrive with the coupling).
-    type Input = ();
-    type Output = Macroscopic;
+    /// The cells moving solids cover (an empty cover: a plain fluid).
+    type Input = SolidCover;
+    /// Force on the solid in each covered cell, averaged over the last advance.
+    type Output = CellForces;
     type Snapshot = LbmSnapshot<T>;
 
     fn time(&self) -> f64 {
@@ -256,7 +308,7 @@ impl<T: Real> Scale for Lbm<T> {
         self.units.dt
     }
     /// Advance by `dt`, which must be a whole number of lattice steps (within 1e-9).
-    fn advance(&mut self, _input: &(), dt: f64) -> Result<()> {
+    fn advance(&mut self, input: &SolidCover, dt: f64) -> Result<()> {
         let n = dt / self.units.dt;
         let k = n.round();
         if (n - k).abs() > 1e-9 * n.max(1.0) || k < 1.0 {
@@ -265,11 +317,32 @@ impl<T: Real> Scale for Lbm<T> {
                 self.units.dt
             )));
         }
-        Fluid::steps(self, k as u64);
+        self.set_cover(input);
+        let (sum, count) = &mut self.exchange_sum;
+        sum.clear();
+        sum.resize(input.cells.len(), [0.0; 2]);
+        *count = 0;
+        for _ in 0..k as u64 {
+            self.step();
+            let (sum, count) = &mut self.exchange_sum;
+            for (s, e) in sum.iter_mut().zip(&self.partial.exchange) {
+                s[0] += e[0];
+                s[1] += e[1];
+            }
+            *count += 1;
+        }
         Ok(())
     }
-    fn observe(&self, out: &mut Macroscopic) {
-        self.macroscopic_into(out)
+    /// Force on the solid per covered cell, F = −Δp (N/m), seed eq. 5.53.
+    fn observe(&self, out: &mut CellForces) {
+        let (sum, count) = &self.exchange_sum;
+        let k = (*count).max(1) as f64;
+        out.fx.clear();
+        out.fy.clear();
+        for s in sum {
+            out.fx.push(-self.units.force_to_si(s[0] / k));
+            out.fy.push(-self.units.force_to_si(s[1] / k));
+        }
     }
     fn snapshot(&self) -> LbmSnapshot<T> {
         let (populations, next_even) = self.lattice.state();

@@ -382,7 +382,8 @@ fn recirculation_end(profile: &[Option<(f64, f64, f64)>], rear: f64) -> Option<f
 // ---------------------------------------------------------------------------------------------
 
 /// Sangani & Acrivos (1982), square array, dimensionless drag F/(μU) per solid fraction Φ.
-const SANGANI_ACRIVOS: [(f64, f64); 4] = [(0.05, 15.56), (0.1, 24.83), (0.2, 51.53), (0.4, 217.89)];
+pub(crate) const SANGANI_ACRIVOS: [(f64, f64); 4] =
+    [(0.05, 15.56), (0.1, 24.83), (0.2, 51.53), (0.4, 217.89)];
 
 /// Steady drag of one array cell.
 #[derive(Clone, Copy, Debug)]

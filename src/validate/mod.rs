@@ -16,6 +16,8 @@ mod les;
 mod poiseuille;
 mod taylor_green;
 
+pub(crate) use cylinder::SANGANI_ACRIVOS;
+
 /// One checked quantity.
 #[derive(Clone, Debug, Serialize)]
 pub struct Check {
@@ -310,6 +312,26 @@ pub const CASES: &[Case] = &[
         name: "dem-polygon",
         description: "rapier2d detector = cell list on disks; polygon grains: rest, rough incline, momentum, budget",
         run: |f| checks_only(crate::dem::validation_polygon::polygons(f)),
+    },
+    Case {
+        name: "psm-cylinder-array",
+        description: "partially saturated cells: Sangani–Acrivos drag within 5 %, d ≥ 20 cells",
+        run: crate::coupling::validation::psm_cylinder_array,
+    },
+    Case {
+        name: "coupling-momentum",
+        description: "fluid + grain momentum in a closed periodic box to 1e-10 relative",
+        run: crate::coupling::validation::momentum,
+    },
+    Case {
+        name: "settling-disk",
+        description: "disk settling in a channel: u_t converges with d, vs Faxén's drag",
+        run: crate::coupling::validation::settling,
+    },
+    Case {
+        name: "dkt",
+        description: "two disks draft, kiss (gap < Δx) and tumble; times reported",
+        run: crate::coupling::validation::dkt,
     },
 ];
 

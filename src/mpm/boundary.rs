@@ -12,8 +12,10 @@
 //!   v_t ← v_t · max(0, 1 − μ Δv_n/|v_t|) (the impulse m Δv_t is bounded by μ m Δv_n);
 //!   separating nodes (v_n ≥ 0) are free.
 //!
-//! The kinetic energy each constraint takes out, ½ m (|v_before|² − |v_after|²), is returned
-//! so the energy budget can book it (tangential part: friction; normal part: impact).
+//! Each constraint returns the velocity change it made, split into its normal and tangential
+//! parts, so the solver can book the work of the constraint impulse (see
+//! [`super::solver`]: D = −m Δv·(v^{n+1} + v^n)/2, the midpoint rule that makes the nodal
+//! kinetic energy balance exact; a wall holding a node at rest does no work).
 
 use serde::{Deserialize, Serialize};
 
@@ -77,36 +79,35 @@ impl Wall {
         }
     }
 
-    /// Apply the condition to velocity `v` of a node of mass `m`; returns the kinetic energy
-    /// removed, split into (normal, tangential) parts.
+    /// Apply the condition to the velocity `v` of a node; returns the velocity change, split
+    /// into (normal, tangential) parts.
     #[inline]
-    pub fn apply(&self, v: &mut [f64; 2], m: f64) -> (f64, f64) {
+    pub fn apply(&self, v: &mut [f64; 2]) -> ([f64; 2], [f64; 2]) {
         let n = self.normal();
         let vn = v[0] * n[0] + v[1] * n[1];
         let vt = [v[0] - vn * n[0], v[1] - vn * n[1]];
-        let vt2 = vt[0] * vt[0] + vt[1] * vt[1];
+        let dn = [-vn * n[0], -vn * n[1]];
         match self.kind {
             WallKind::Fixed => {
                 *v = [0.0; 2];
-                (0.5 * m * vn * vn, 0.5 * m * vt2)
+                (dn, [-vt[0], -vt[1]])
             }
             WallKind::Roller => {
                 *v = vt;
-                (0.5 * m * vn * vn, 0.0)
+                (dn, [0.0; 2])
             }
             WallKind::Friction { mu } => {
                 if vn >= 0.0 {
-                    return (0.0, 0.0);
+                    return ([0.0; 2], [0.0; 2]);
                 }
-                let dvn = -vn;
-                let speed = vt2.sqrt();
+                let speed = (vt[0] * vt[0] + vt[1] * vt[1]).sqrt();
                 let scale = if speed > 0.0 {
-                    (1.0 - mu * dvn / speed).max(0.0)
+                    (1.0 - mu * (-vn) / speed).max(0.0)
                 } else {
                     0.0
                 };
                 *v = [vt[0] * scale, vt[1] * scale];
-                (0.5 * m * vn * vn, 0.5 * m * vt2 * (1.0 - scale * scale))
+                (dn, [vt[0] * (scale - 1.0), vt[1] * (scale - 1.0)])
             }
         }
     }
@@ -117,7 +118,7 @@ mod tests {
     use super::*;
 
     /// Coulomb: the tangential impulse equals μ × the normal impulse while sliding, and
-    /// sticking takes all tangential velocity; separation is free; energy is booked.
+    /// sticking takes all tangential velocity; separation is free; the changes are reported.
     #[test]
     fn coulomb_wall_limits_the_tangential_impulse() {
         let w = Wall {
@@ -126,14 +127,14 @@ mod tests {
             kind: WallKind::Friction { mu: 0.5 },
         };
         let mut v = [2.0, -1.0];
-        let (en, et) = w.apply(&mut v, 3.0);
+        let (dn, dt) = w.apply(&mut v);
         assert_eq!(v, [1.5, 0.0]);
-        assert!((en - 1.5).abs() < 1e-15 && (et - 0.5 * 3.0 * (4.0 - 2.25)).abs() < 1e-12);
+        assert_eq!((dn, dt), ([0.0, 1.0], [-0.5, 0.0]));
         let mut v = [0.2, -1.0];
-        w.apply(&mut v, 1.0);
+        w.apply(&mut v);
         assert_eq!(v, [0.0, 0.0]);
         let mut v = [0.2, 1.0];
-        assert_eq!(w.apply(&mut v, 1.0), (0.0, 0.0));
+        assert_eq!(w.apply(&mut v), ([0.0; 2], [0.0; 2]));
         assert_eq!(v, [0.2, 1.0]);
         let r = Wall {
             side: Side::Left,
@@ -141,7 +142,7 @@ mod tests {
             kind: WallKind::Roller,
         };
         let mut v = [0.3, -0.4];
-        r.apply(&mut v, 1.0);
+        r.apply(&mut v);
         assert_eq!(v, [0.0, -0.4]);
     }
 }

@@ -81,19 +81,21 @@ impl Grid {
         ]
     }
 
-    /// Apply the walls of node `n` to velocity `v` (mass `m`): energy removed (normal, tangential).
+    /// Apply the walls of a node (bit mask `mask`) to its velocity `v`; returns the total
+    /// velocity change (normal parts, tangential parts).
     #[inline]
-    pub fn constrain(walls: &[Wall], mask: u8, v: &mut [f64; 2], m: f64) -> (f64, f64) {
-        let mut e = (0.0, 0.0);
+    pub fn constrain(walls: &[Wall], mask: u8, v: &mut [f64; 2]) -> ([f64; 2], [f64; 2]) {
+        let mut dn = [0.0; 2];
+        let mut dt = [0.0; 2];
         if mask != 0 {
             for (k, w) in walls.iter().enumerate() {
                 if mask & (1 << k) != 0 {
-                    let d = w.apply(v, m);
-                    e.0 += d.0;
-                    e.1 += d.1;
+                    let (a, b) = w.apply(v);
+                    dn = [dn[0] + a[0], dn[1] + a[1]];
+                    dt = [dt[0] + b[0], dt[1] + b[1]];
                 }
             }
         }
-        e
+        (dn, dt)
     }
 }

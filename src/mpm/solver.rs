@@ -19,6 +19,13 @@
 //! * velocity gradient L = Σ_i v_i ⊗ ∇N_ip, Δε = Δt sym L, spin Δω = Δt ½(L_xy − L_yx),
 //!   F ← (I + Δt L) F, V = det F · V₀, σ ← material(σ, Δε, Δω).
 //!
+//! Energy bookkeeping ([`MpmEnergy`]): kinetic and potential energy of the points; elastic
+//! energy ½ σ:C⁻¹:σ V; plastic dissipation = stress work Σ σ_mid:Δε V − elastic energy; the
+//! work taken out by wall impulses, D = −m_i Δv_i·(v_i^{n+1} + v_i^n)/2 per constrained node
+//! and step (normal part: impact; tangential part: friction; zero for a node held at rest);
+//! local damping work α|f|·|v|Δt. What is left, E_total(t) − E_total(0), is the scheme's own
+//! numerical dissipation (the FLIP/PIC transfers), reported as the budget error.
+//!
 //! Time step: Δt ≤ C h/c with c = √((K + 4G/3)/ρ) the P-wave speed and C the Courant number;
 //! a larger step is refused (Error::Config on `time.dt`).
 //!
@@ -78,9 +85,9 @@ pub struct MpmEnergy {
     pub elastic: f64,
     /// Plastic dissipation: stress work (including the initial elastic energy) − elastic energy.
     pub plastic: f64,
-    /// Kinetic energy removed by wall constraints, normal part (impact on the walls).
+    /// Work taken out by the walls' normal impulses (impact), −Σ m Δv_n·v_mid.
     pub boundary_normal: f64,
-    /// Kinetic energy removed by wall friction (tangential part).
+    /// Work taken out by wall friction, −Σ m Δv_t·v_mid.
     pub boundary_friction: f64,
     /// Work of the local damping forces.
     pub damping: f64,
@@ -427,7 +434,7 @@ impl Mpm {
                 if s[0] > eps {
                     *v = [s[1] / s[0], s[2] / s[0]];
                     if into_map {
-                        Grid::constrain(walls, mask, v, s[0]);
+                        Grid::constrain(walls, mask, v);
                     }
                 } else {
                     *v = [0.0; 2];
@@ -461,7 +468,11 @@ impl Mpm {
                     }
                 }
                 *vn = [v[0] + dt * f[0] / s[0], v[1] + dt * f[1] / s[0]];
-                let (en, et) = Grid::constrain(walls, mask, vn, s[0]);
+                let (dn, dtan) = Grid::constrain(walls, mask, vn);
+                // Work of the wall impulse m Δv at the midpoint velocity (v^{n+1} + v^n)/2.
+                let mid = [0.5 * (vn[0] + v[0]), 0.5 * (vn[1] + v[1])];
+                let en = -s[0] * (dn[0] * mid[0] + dn[1] * mid[1]);
+                let et = -s[0] * (dtan[0] * mid[0] + dtan[1] * mid[1]);
                 [en, et, damp]
             })
             .reduce(|| [0.0; 3], |a, b| [a[0] + b[0], a[1] + b[1], a[2] + b[2]]);

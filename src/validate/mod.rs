@@ -306,6 +306,26 @@ pub const CASES: &[Case] = &[
         description: "DEM energy budget of a settling run closes within 1 %",
         run: |f| checks_only(crate::dem::validation::energy_budget(f)),
     },
+    Case {
+        name: "mpm-selfweight",
+        description: "elastic column under gravity: σ_yy = −ρg(H − y) within 2 % of ρgH",
+        run: |f| checks_only(crate::mpm::validation::selfweight(f)),
+    },
+    Case {
+        name: "mpm-mc-biaxial",
+        description: "Mohr–Coulomb plane-strain biaxial: peak σ₁ within 1 %, ψ = 0 isochoric",
+        run: |f| checks_only(crate::mpm::validation::mc_biaxial(f)),
+    },
+    Case {
+        name: "mpm-cell-crossing",
+        description: "block translating across cells: GIMP stress noise ≥ 10× below standard MPM",
+        run: |f| checks_only(crate::mpm::validation::cell_crossing(f)),
+    },
+    Case {
+        name: "mpm-conservation",
+        description: "MPM mass exact, momentum to round-off (USF, USL, MUSL)",
+        run: |f| checks_only(crate::mpm::validation::conservation(f)),
+    },
 ];
 
 /// A report of checks without figures.

@@ -255,7 +255,10 @@ fn check_dem(path: &Path) -> Result<ExitCode> {
 fn check_mpm(path: &Path) -> Result<ExitCode> {
     let s = granflow::mpm::scenario::MpmScenario::from_file(path)?;
     let d = s.derive()?;
-    println!("scenario        {} — {} (MPM column collapse)", s.name, s.description);
+    println!(
+        "scenario        {} — {} (MPM column collapse)",
+        s.name, s.description
+    );
     println!(
         "column          L_i = {:.4e} m, H_i = {:.4e} m, τ_c = {:.4e} s",
         s.column.width, d.height, d.tau_c
@@ -264,8 +267,14 @@ fn check_mpm(path: &Path) -> Result<ExitCode> {
         "grid            {} × {} cells of {:.4e} m, {} points",
         d.cells[0], d.cells[1], s.mpm.cell_size, d.points
     );
-    println!("wave speed      c = √((K + 4G/3)/ρ) = {:.4} m/s", d.wave_speed);
-    println!("dt (CFL)        {:.4e} s (Courant {})", d.dt_cfl, s.mpm.courant);
+    println!(
+        "wave speed      c = √((K + 4G/3)/ρ) = {:.4} m/s",
+        d.wave_speed
+    );
+    println!(
+        "dt (CFL)        {:.4e} s (Courant {})",
+        d.dt_cfl, s.mpm.courant
+    );
     if let Some(dt) = s.time.dt {
         println!("dt              {dt:.4e} s (given)");
     }

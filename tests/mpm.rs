@@ -54,8 +54,12 @@ fn collapse_models_parse_and_match_the_dem_geometry() {
         assert_eq!(s.column.width, dem.column.width);
         assert_eq!(s.column.aspect_ratio, dem.column.aspect_ratio);
         assert_eq!(s.column.box_length, dem.column.box_length);
-        assert_eq!(d.points, (d.height / s.mpm.cell_size).round() as usize
-            * (s.column.width / s.mpm.cell_size).round() as usize * 16);
+        assert_eq!(
+            d.points,
+            (d.height / s.mpm.cell_size).round() as usize
+                * (s.column.width / s.mpm.cell_size).round() as usize
+                * 16
+        );
     }
 }
 
@@ -64,19 +68,31 @@ fn collapse_models_parse_and_match_the_dem_geometry() {
 #[test]
 fn bad_scenarios_are_refused_naming_the_field() {
     let text = std::fs::read_to_string(model("2")).unwrap();
-    let e = MpmScenario::from_toml(&text.replace("cohesion = 0.0", "cohesion = 0.0\ncohesio = 1.0"))
-        .unwrap_err()
-        .to_string();
+    let e =
+        MpmScenario::from_toml(&text.replace("cohesion = 0.0", "cohesion = 0.0\ncohesio = 1.0"))
+            .unwrap_err()
+            .to_string();
     assert!(e.contains("cohesio"), "{e}");
-    let s = MpmScenario::from_toml(&text.replace("friction_angle_deg = 22.2", "friction_angle_deg = -1.0")).unwrap();
+    let s = MpmScenario::from_toml(
+        &text.replace("friction_angle_deg = 22.2", "friction_angle_deg = -1.0"),
+    )
+    .unwrap();
     let e = s.derive().unwrap_err().to_string();
     assert!(e.contains("material.friction_angle_deg"), "{e}");
-    let s = MpmScenario::from_toml(&text.replace("cell_size = 0.0019375", "cell_size = 0.002")).unwrap();
-    assert!(s.derive().unwrap_err().to_string().contains("mpm.cell_size"));
+    let s = MpmScenario::from_toml(&text.replace("cell_size = 0.0019375", "cell_size = 0.002"))
+        .unwrap();
+    assert!(s
+        .derive()
+        .unwrap_err()
+        .to_string()
+        .contains("mpm.cell_size"));
     // c ≈ 34.53 m/s, h = 1.9375 mm, C = 0.5: limit ≈ 2.8e-5 s.
     let s = MpmScenario::from_toml(&text.replace("[time]\n", "[time]\ndt = 1.0e-4\n")).unwrap();
     let e = s.derive().unwrap_err().to_string();
-    assert!(e.contains("time.dt") && e.contains("CFL limit") && e.contains("2.80"), "{e}");
+    assert!(
+        e.contains("time.dt") && e.contains("CFL limit") && e.contains("2.80"),
+        "{e}"
+    );
     let e = s.build().unwrap_err().to_string();
     assert!(e.contains("time.dt"), "{e}");
     let s = MpmScenario::from_toml(&text.replace("[time]\n", "[time]\ndt = 1.0e-6\n")).unwrap();
@@ -93,11 +109,28 @@ fn short_collapse_writes_the_output_contract() {
     let r = granflow::mpm::run::run_column_collapse(&s, dir.path(), &mut |_, _| {}).unwrap();
     assert!(!r.at_rest && r.l_f > 1.05 * r.l_i, "{r:?}");
     let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap()).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
     for key in [
-        "name", "grains", "packing_fraction", "l_i", "h_i", "aspect_ratio", "tau_c", "l_f", "h_f",
-        "delta_l", "h_f_over_l_i", "stop_time_tc", "at_rest", "dt", "steps", "wall_time_s",
-        "deposition_wall_time_s", "particle_steps_per_s", "energy_budget_error",
+        "name",
+        "grains",
+        "packing_fraction",
+        "l_i",
+        "h_i",
+        "aspect_ratio",
+        "tau_c",
+        "l_f",
+        "h_f",
+        "delta_l",
+        "h_f_over_l_i",
+        "stop_time_tc",
+        "at_rest",
+        "dt",
+        "steps",
+        "wall_time_s",
+        "deposition_wall_time_s",
+        "particle_steps_per_s",
+        "energy_budget_error",
     ] {
         assert!(json.get(key).is_some(), "summary lacks {key}");
     }
@@ -107,7 +140,16 @@ fn short_collapse_writes_the_output_contract() {
     assert!(pvd.contains("points_000000.vtu") && pvd.contains("grid_000000.vti"));
     // Energy: the booked total may only fall (numerical dissipation), never rise.
     let e = r.energy;
-    let total = e.kinetic + e.potential + e.elastic + e.dissipated_plastic + e.dissipated_normal
-        + e.dissipated_friction + e.dissipated_damping;
-    assert!(total <= r.potential_initial * (1.0 + 1e-6), "{total} > {}", r.potential_initial);
+    let total = e.kinetic
+        + e.potential
+        + e.elastic
+        + e.dissipated_plastic
+        + e.dissipated_normal
+        + e.dissipated_friction
+        + e.dissipated_damping;
+    assert!(
+        total <= r.potential_initial * (1.0 + 1e-6),
+        "{total} > {}",
+        r.potential_initial
+    );
 }

@@ -48,9 +48,21 @@ pub fn column(n: usize, shape: ShapeKind) -> Result<Mpm> {
     let (nx, ny) = (4 * w + 4, 2 * w + 6);
     let friction = WallKind::Friction { mu: 0.466 };
     let walls = vec![
-        Wall { side: Side::Bottom, position: 0.0, kind: friction },
-        Wall { side: Side::Left, position: 0.0, kind: friction },
-        Wall { side: Side::Right, position: (nx - 4) as f64 * h, kind: friction },
+        Wall {
+            side: Side::Bottom,
+            position: 0.0,
+            kind: friction,
+        },
+        Wall {
+            side: Side::Left,
+            position: 0.0,
+            kind: friction,
+        },
+        Wall {
+            side: Side::Right,
+            position: (nx - 4) as f64 * h,
+            kind: friction,
+        },
     ];
     let grid = Grid::new(nx, ny, h, [-2.0 * h, -2.0 * h], walls);
     let material = MaterialModel::MohrCoulomb(MohrCoulomb {
@@ -84,9 +96,17 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 /// Run the benchmark on `threads` threads (0: rayon's default).
-pub fn mpm(points: usize, steps: u64, threads: usize, repeats: usize, shape: ShapeKind) -> Result<MpmBench> {
+pub fn mpm(
+    points: usize,
+    steps: u64,
+    threads: usize,
+    repeats: usize,
+    shape: ShapeKind,
+) -> Result<MpmBench> {
     if points < 32 || steps == 0 || repeats == 0 {
-        return Err(Error::Other("bench mpm: need points ≥ 32 and steps, repeats ≥ 1".into()));
+        return Err(Error::Other(
+            "bench mpm: need points ≥ 32 and steps, repeats ≥ 1".into(),
+        ));
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)

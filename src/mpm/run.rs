@@ -145,8 +145,12 @@ pub fn shape(mpm: &Mpm) -> Shape {
     let g = &mpm.grid;
     let (nx, ny) = (g.nx, g.ny);
     let cell = |x: [f64; 2]| -> usize {
-        let i = ((x[0] - g.origin[0]) / g.h).floor().clamp(0.0, (nx - 1) as f64) as usize;
-        let j = ((x[1] - g.origin[1]) / g.h).floor().clamp(0.0, (ny - 1) as f64) as usize;
+        let i = ((x[0] - g.origin[0]) / g.h)
+            .floor()
+            .clamp(0.0, (nx - 1) as f64) as usize;
+        let j = ((x[1] - g.origin[1]) / g.h)
+            .floor()
+            .clamp(0.0, (ny - 1) as f64) as usize;
         i * ny + j
     };
     let mut count = vec![0u32; nx * ny];
@@ -183,10 +187,10 @@ pub fn shape(mpm: &Mpm) -> Shape {
         }
     }
     let mut size = vec![0u32; nx * ny];
-    for c in 0..nx * ny {
-        if count[c] > 0 {
+    for (c, &k) in count.iter().enumerate() {
+        if k > 0 {
             let r = find(&mut parent, c as u32);
-            size[r as usize] += count[c];
+            size[r as usize] += k;
         }
     }
     let main = (0..nx * ny).max_by_key(|&r| size[r]).unwrap_or(0) as u32;
@@ -199,7 +203,11 @@ pub fn shape(mpm: &Mpm) -> Shape {
             height = height.max(x[1] + lp);
         }
     }
-    Shape { runout, front, height }
+    Shape {
+        runout,
+        front,
+        height,
+    }
 }
 
 fn write_frame(mpm: &Mpm, dir: &Path, k: usize, pvd: &mut PvdSeries) -> Result<()> {
@@ -234,8 +242,12 @@ fn write_frame(mpm: &Mpm, dir: &Path, k: usize, pvd: &mut PvdSeries) -> Result<(
     let mut mv = vec![[0.0; 2]; g.nx * g.ny];
     for q in 0..n {
         let x = p.pos[q];
-        let i = ((x[0] - g.origin[0]) / g.h).floor().clamp(0.0, (g.nx - 1) as f64) as usize;
-        let j = ((x[1] - g.origin[1]) / g.h).floor().clamp(0.0, (g.ny - 1) as f64) as usize;
+        let i = ((x[0] - g.origin[0]) / g.h)
+            .floor()
+            .clamp(0.0, (g.nx - 1) as f64) as usize;
+        let j = ((x[1] - g.origin[1]) / g.h)
+            .floor()
+            .clamp(0.0, (g.ny - 1) as f64) as usize;
         // VTK image cells are x-fastest.
         let c = j * g.nx + i;
         rho[c] += p.mass[q];
@@ -245,7 +257,13 @@ fn write_frame(mpm: &Mpm, dir: &Path, k: usize, pvd: &mut PvdSeries) -> Result<(
     let vel: Vec<[f64; 2]> = rho
         .iter()
         .zip(&mv)
-        .map(|(&m, v)| if m > 0.0 { [v[0] / m, v[1] / m] } else { [0.0; 2] })
+        .map(|(&m, v)| {
+            if m > 0.0 {
+                [v[0] / m, v[1] / m]
+            } else {
+                [0.0; 2]
+            }
+        })
         .collect();
     rho.iter_mut().for_each(|m| *m /= g.h * g.h);
     let gname = format!("grid_{k:06}.vti");
@@ -257,7 +275,10 @@ fn write_frame(mpm: &Mpm, dir: &Path, k: usize, pvd: &mut PvdSeries) -> Result<(
             origin: g.origin,
             spacing: [g.h, g.h],
         },
-        &[Field::scalar("density", &rho), Field::vector("velocity", &vel)],
+        &[
+            Field::scalar("density", &rho),
+            Field::vector("velocity", &vel),
+        ],
     )?;
     pvd.add(mpm.time(), 0, &name)?;
     pvd.add(mpm.time(), 1, &gname)

@@ -164,7 +164,10 @@ fn positive(field: &str, v: f64) -> Result<()> {
     if v > 0.0 && v.is_finite() {
         Ok(())
     } else {
-        Err(Error::config(field, format!("must be finite and > 0, got {v}")))
+        Err(Error::config(
+            field,
+            format!("must be finite and > 0, got {v}"),
+        ))
     }
 }
 
@@ -172,7 +175,10 @@ fn non_negative(field: &str, v: f64) -> Result<()> {
     if v >= 0.0 && v.is_finite() {
         Ok(())
     } else {
-        Err(Error::config(field, format!("must be finite and ≥ 0, got {v}")))
+        Err(Error::config(
+            field,
+            format!("must be finite and ≥ 0, got {v}"),
+        ))
     }
 }
 
@@ -207,7 +213,9 @@ impl MaterialSpec {
                 density,
                 youngs_modulus,
                 poisson_ratio,
-            } => MaterialModel::Elastic(elastic("material", density, youngs_modulus, poisson_ratio)?),
+            } => {
+                MaterialModel::Elastic(elastic("material", density, youngs_modulus, poisson_ratio)?)
+            }
             MaterialSpec::MohrCoulomb {
                 density,
                 youngs_modulus,
@@ -227,7 +235,9 @@ impl MaterialSpec {
                 if !(dilatancy_angle_deg >= 0.0 && dilatancy_angle_deg <= friction_angle_deg) {
                     return Err(Error::config(
                         "material.dilatancy_angle_deg",
-                        format!("must be in [0, φ = {friction_angle_deg}], got {dilatancy_angle_deg}"),
+                        format!(
+                            "must be in [0, φ = {friction_angle_deg}], got {dilatancy_angle_deg}"
+                        ),
                     ));
                 }
                 non_negative("material.cohesion", cohesion)?;
@@ -272,7 +282,10 @@ impl MpmScenario {
         if c.box_length <= c.width {
             return Err(Error::config(
                 "column.box_length",
-                format!("must exceed the column width {} m, got {} m", c.width, c.box_length),
+                format!(
+                    "must exceed the column width {} m, got {} m",
+                    c.width, c.box_length
+                ),
             ));
         }
         let m = &self.mpm;
@@ -280,14 +293,23 @@ impl MpmScenario {
         if !(1..=8).contains(&m.points_per_cell) {
             return Err(Error::config(
                 "mpm.points_per_cell",
-                format!("must be 1..=8 (points per cell per direction), got {}", m.points_per_cell),
+                format!(
+                    "must be 1..=8 (points per cell per direction), got {}",
+                    m.points_per_cell
+                ),
             ));
         }
         if !(m.courant > 0.0 && m.courant <= 1.0) {
-            return Err(Error::config("mpm.courant", format!("must be in (0, 1], got {}", m.courant)));
+            return Err(Error::config(
+                "mpm.courant",
+                format!("must be in (0, 1], got {}", m.courant),
+            ));
         }
         if !(m.damping >= 0.0 && m.damping < 1.0) {
-            return Err(Error::config("mpm.damping", format!("must be in [0, 1), got {}", m.damping)));
+            return Err(Error::config(
+                "mpm.damping",
+                format!("must be in [0, 1), got {}", m.damping),
+            ));
         }
         let height = c.aspect_ratio * c.width;
         let h = m.cell_size;
@@ -340,9 +362,21 @@ impl MpmScenario {
         let h = self.mpm.cell_size;
         let end = (self.column.box_length / h).ceil() * h;
         let walls = vec![
-            Wall { side: Side::Bottom, position: 0.0, kind: self.walls.base },
-            Wall { side: Side::Left, position: 0.0, kind: self.walls.back },
-            Wall { side: Side::Right, position: end, kind: self.walls.end },
+            Wall {
+                side: Side::Bottom,
+                position: 0.0,
+                kind: self.walls.base,
+            },
+            Wall {
+                side: Side::Left,
+                position: 0.0,
+                kind: self.walls.back,
+            },
+            Wall {
+                side: Side::Right,
+                position: end,
+                kind: self.walls.end,
+            },
         ];
         let grid = Grid::new(d.cells[0], d.cells[1], h, [-2.0 * h, -2.0 * h], walls);
         let mut pts = Points::default();

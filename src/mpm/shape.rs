@@ -107,7 +107,9 @@ mod tests {
     const H: f64 = 0.1;
 
     fn positions() -> Vec<f64> {
-        (0..997).map(|k| 0.3 + 0.7 * k as f64 / 996.0 * H * 3.0).collect()
+        (0..997)
+            .map(|k| 0.3 + 0.7 * k as f64 / 996.0 * H * 3.0)
+            .collect()
     }
 
     /// Σ_i S_i = 1 and Σ_i S′_i = 0 at every position, both kinds (to round-off).
@@ -166,7 +168,10 @@ mod tests {
         for b in [lp, H - lp, H + lp] {
             for s in [-1.0, 1.0] {
                 let (a, c) = (gimp_1d(s * b - 1e-12, H, lp), gimp_1d(s * b + 1e-12, H, lp));
-                assert!((a.0 - c.0).abs() < 1e-9 && (a.1 - c.1).abs() < 1e-8, "b={b}");
+                assert!(
+                    (a.0 - c.0).abs() < 1e-9 && (a.1 - c.1).abs() < 1e-8,
+                    "b={b}"
+                );
             }
         }
         assert!((hat_1d(-1e-12, H).1 - hat_1d(1e-12, H).1).abs() > 1.0);

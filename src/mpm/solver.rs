@@ -185,7 +185,12 @@ impl Mpm {
     /// Assemble a system. Refuses (naming `time.dt`) a step above the CFL limit, a Courant
     /// number outside (0, 1], damping outside [0, 1), more than 8 walls, or points outside
     /// the grid's interior.
-    pub fn new(grid: Grid, points: Points, material: MaterialModel, params: MpmParams) -> Result<Self> {
+    pub fn new(
+        grid: Grid,
+        points: Points,
+        material: MaterialModel,
+        params: MpmParams,
+    ) -> Result<Self> {
         if !(params.courant > 0.0 && params.courant <= 1.0) {
             return Err(Error::config(
                 "mpm.courant",
@@ -276,8 +281,12 @@ impl Mpm {
     fn resort(&mut self) {
         let g = &self.grid;
         let key = |p: [f64; 2]| -> usize {
-            let cx = ((p[0] - g.origin[0]) / g.h).floor().clamp(0.0, (g.nx - 1) as f64) as usize;
-            let cy = ((p[1] - g.origin[1]) / g.h).floor().clamp(0.0, (g.ny - 1) as f64) as usize;
+            let cx = ((p[0] - g.origin[0]) / g.h)
+                .floor()
+                .clamp(0.0, (g.nx - 1) as f64) as usize;
+            let cy = ((p[1] - g.origin[1]) / g.h)
+                .floor()
+                .clamp(0.0, (g.ny - 1) as f64) as usize;
             cx * g.ny + cy
         };
         let ncells = g.nx * g.ny;
@@ -307,7 +316,13 @@ impl Mpm {
         let shape = self.params.shape;
         let ns = self.stripe_start.len() - 1;
         self.stripe_start.iter_mut().for_each(|c| *c = 0);
-        for (p, (&x, &lp)) in self.points.pos.iter().zip(&self.points.half_size).enumerate() {
+        for (p, (&x, &lp)) in self
+            .points
+            .pos
+            .iter()
+            .zip(&self.points.half_size)
+            .enumerate()
+        {
             let st = stencil(shape, g.origin, g.h, x, lp);
             let ok = x[0].is_finite()
                 && x[1].is_finite()
@@ -476,8 +491,8 @@ impl Mpm {
                 [en, et, damp]
             })
             .reduce(|| [0.0; 3], |a, b| [a[0] + b[0], a[1] + b[1], a[2] + b[2]]);
-        for k in 0..3 {
-            self.booked[k] += e[k];
+        for (b, v) in self.booked.iter_mut().zip(e) {
+            *b += v;
         }
     }
 
@@ -493,7 +508,10 @@ impl Mpm {
         let shape = self.params.shape;
         let dt = self.dt;
         let mat = &self.material;
-        let do_v = matches!(pass, PointPass::Velocity | PointPass::All | PointPass::VelocityAndMove);
+        let do_v = matches!(
+            pass,
+            PointPass::Velocity | PointPass::All | PointPass::VelocityAndMove
+        );
         let do_x = matches!(
             pass,
             PointPass::All | PointPass::StressFromMapAndMove | PointPass::VelocityAndMove
@@ -561,7 +579,7 @@ impl Mpm {
                             a[2] * f[1] + a[3] * f[3],
                         ];
                         let j = fnew[0] * fnew[3] - fnew[1] * fnew[2];
-                        if !(j > 0.0) && bad.is_none() {
+                        if (j.is_nan() || j <= 0.0) && bad.is_none() {
                             bad = Some((k * CHUNK + q, format!("det F = {j:e} ≤ 0")));
                         }
                         fg[q] = fnew;
@@ -570,8 +588,13 @@ impl Mpm {
                         let spin = 0.5 * dt * (l[1] - l[2]);
                         let s0 = sig[q];
                         let s1 = mat.update_stress(&s0, &de, spin, &mut state[q]);
-                        let smid = [0.5 * (s0[0] + s1[0]), 0.5 * (s0[1] + s1[1]), 0.5 * (s0[2] + s1[2])];
-                        work[q] += 0.5 * (vol[q] + vnew_)
+                        let smid = [
+                            0.5 * (s0[0] + s1[0]),
+                            0.5 * (s0[1] + s1[1]),
+                            0.5 * (s0[2] + s1[2]),
+                        ];
+                        work[q] += 0.5
+                            * (vol[q] + vnew_)
                             * (smid[0] * de[0] + smid[1] * de[1] + 2.0 * smid[2] * de[2]);
                         sig[q] = s1;
                         vol[q] = vnew_;
@@ -600,7 +623,10 @@ impl Mpm {
 
     /// One explicit step of the chosen scheme.
     pub fn step(&mut self) -> Result<()> {
-        if self.params.resort_every > 0 && self.steps % self.params.resort_every == 0 && self.steps > 0 {
+        if self.params.resort_every > 0
+            && self.steps.is_multiple_of(self.params.resort_every)
+            && self.steps > 0
+        {
             self.resort();
         }
         self.bin()?;
@@ -671,7 +697,10 @@ impl Mpm {
                     p.work[q] - el,
                 ]
             })
-            .reduce(|| [0.0; 4], |a, b| [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]);
+            .reduce(
+                || [0.0; 4],
+                |a, b| [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]],
+            );
         MpmEnergy {
             kinetic: s[0],
             potential: s[1],

@@ -59,7 +59,13 @@ fn block(
     pts.fill_rect([0.0, 0.0], [w, hgt], h, n, material_density(&material));
     let nx = (w / h).round() as usize + pad[0] + pad[1];
     let ny = (hgt / h).round() as usize + pad[2] + pad[3];
-    let grid = Grid::new(nx, ny, h, [-(pad[0] as f64) * h, -(pad[2] as f64) * h], walls);
+    let grid = Grid::new(
+        nx,
+        ny,
+        h,
+        [-(pad[0] as f64) * h, -(pad[2] as f64) * h],
+        walls,
+    );
     Mpm::new(grid, pts, material, params)
 }
 
@@ -91,14 +97,35 @@ pub fn selfweight(fidelity: Fidelity) -> Result<Vec<Check>> {
     let h = hgt / cells as f64;
     let w = 4.0 * h;
     let walls = vec![
-        Wall { side: Side::Left, position: 0.0, kind: WallKind::Roller },
-        Wall { side: Side::Right, position: w, kind: WallKind::Roller },
-        Wall { side: Side::Bottom, position: 0.0, kind: WallKind::Fixed },
+        Wall {
+            side: Side::Left,
+            position: 0.0,
+            kind: WallKind::Roller,
+        },
+        Wall {
+            side: Side::Right,
+            position: w,
+            kind: WallKind::Roller,
+        },
+        Wall {
+            side: Side::Bottom,
+            position: 0.0,
+            kind: WallKind::Fixed,
+        },
     ];
     let mat = MaterialModel::Elastic(elastic(rho, 1e7, 0.3));
     // Local damping α = 0.3 (Cundall) takes the column to rest; 2 s ≈ 40 fundamental periods
     // 4H/c (c ≈ 82 m/s).
-    let mut mpm = block(w, hgt, h, 2, [2, 2, 2, 3], walls, mat, params(ShapeKind::Gimp, Scheme::Musl, g, 0.3))?;
+    let mut mpm = block(
+        w,
+        hgt,
+        h,
+        2,
+        [2, 2, 2, 3],
+        walls,
+        mat,
+        params(ShapeKind::Gimp, Scheme::Musl, g, 0.3),
+    )?;
     let steps = (2.0 / mpm.dt()).ceil() as u64;
     mpm.steps(steps)?;
     let e = mpm.energy();
@@ -113,9 +140,24 @@ pub fn selfweight(fidelity: Fidelity) -> Result<Vec<Check>> {
     }
     let weight = 0.5 * rho * g * g * hgt * hgt * w;
     Ok(vec![
-        Check::at_most(case, "max |σ_yy − (−ρg(H−Y))| / ρgH over all points", worst, 0.02),
-        Check::report(case, "RMS |σ_yy − (−ρg(H−Y))| / ρgH", (sum2 / n as f64).sqrt(), 0.0),
-        Check::at_most(case, "kinetic energy at the end / ρ g² H² w/2 (at rest)", e.kinetic / weight, 1e-8),
+        Check::at_most(
+            case,
+            "max |σ_yy − (−ρg(H−Y))| / ρgH over all points",
+            worst,
+            0.02,
+        ),
+        Check::report(
+            case,
+            "RMS |σ_yy − (−ρg(H−Y))| / ρgH",
+            (sum2 / n as f64).sqrt(),
+            0.0,
+        ),
+        Check::at_most(
+            case,
+            "kinetic energy at the end / ρ g² H² w/2 (at rest)",
+            e.kinetic / weight,
+            1e-8,
+        ),
     ])
 }
 
@@ -172,7 +214,8 @@ pub fn mc_biaxial(_: Fidelity) -> Result<Vec<Check>> {
         for c in [0.0, 1e4] {
             let m = make(phi, 0.0, c);
             let sp = phi.to_radians().sin();
-            let reference = sigma3 * (1.0 + sp) / (1.0 - sp) + 2.0 * c * phi.to_radians().cos() / (1.0 - sp);
+            let reference =
+                sigma3 * (1.0 + sp) / (1.0 - sp) + 2.0 * c * phi.to_radians().cos() / (1.0 - sp);
             let (peak, ev, ey) = biaxial(&m, sigma3, 2e-5, 2500);
             out.push(Check::rel(
                 case,
@@ -207,10 +250,23 @@ pub fn mc_biaxial(_: Fidelity) -> Result<Vec<Check>> {
 pub fn crossing_noise(shape: ShapeKind, cells_moved: f64, v0: f64) -> Result<(f64, f64)> {
     let (rho, g, h) = (1000.0, 9.81, 0.05);
     let (w, hgt) = (8.0 * h, 4.0 * h);
-    let walls = vec![Wall { side: Side::Bottom, position: 0.0, kind: WallKind::Roller }];
+    let walls = vec![Wall {
+        side: Side::Bottom,
+        position: 0.0,
+        kind: WallKind::Roller,
+    }];
     let mat = MaterialModel::Elastic(elastic(rho, 1e6, 0.3));
     let pad = [2, cells_moved.ceil() as usize + 3, 2, 3];
-    let mut mpm = block(w, hgt, h, 2, pad, walls, mat, params(shape, Scheme::Musl, g, 0.3))?;
+    let mut mpm = block(
+        w,
+        hgt,
+        h,
+        2,
+        pad,
+        walls,
+        mat,
+        params(shape, Scheme::Musl, g, 0.3),
+    )?;
     // Keep the point order fixed, so point k is compared with its own settled stress.
     mpm.params.resort_every = 0;
     // Settle: 1.5 s with damping (≈ 300 periods of the block's vertical mode).
@@ -243,12 +299,33 @@ pub fn compaction_error(shape: ShapeKind, youngs: f64) -> Result<(f64, f64)> {
     let (rho, g, hgt, h) = (1000.0, 9.81, 1.0, 0.05);
     let w = 2.0 * h;
     let walls = vec![
-        Wall { side: Side::Left, position: 0.0, kind: WallKind::Roller },
-        Wall { side: Side::Right, position: w, kind: WallKind::Roller },
-        Wall { side: Side::Bottom, position: 0.0, kind: WallKind::Fixed },
+        Wall {
+            side: Side::Left,
+            position: 0.0,
+            kind: WallKind::Roller,
+        },
+        Wall {
+            side: Side::Right,
+            position: w,
+            kind: WallKind::Roller,
+        },
+        Wall {
+            side: Side::Bottom,
+            position: 0.0,
+            kind: WallKind::Fixed,
+        },
     ];
     let mat = MaterialModel::Elastic(elastic(rho, youngs, 0.0));
-    let mut mpm = block(w, hgt, h, 2, [2, 2, 2, 3], walls, mat, params(shape, Scheme::Musl, g, 0.3))?;
+    let mut mpm = block(
+        w,
+        hgt,
+        h,
+        2,
+        [2, 2, 2, 3],
+        walls,
+        mat,
+        params(shape, Scheme::Musl, g, 0.3),
+    )?;
     let period = 4.0 * hgt / (youngs / rho).sqrt();
     mpm.steps((40.0 * period / mpm.dt()).ceil() as u64)?;
     let scale = rho * g * hgt;
@@ -274,16 +351,61 @@ pub fn cell_crossing(fidelity: Fidelity) -> Result<Vec<Check>> {
     let (cstd_rms, cstd_max) = compaction_error(ShapeKind::Standard, 1e5)?;
     let (cgimp_rms, cgimp_max) = compaction_error(ShapeKind::Gimp, 1e5)?;
     Ok(vec![
-        Check::report(case, "translation: standard MPM RMS Δσ_yy/ρgH while crossing cells", std_rms, 0.0),
-        Check::report(case, "translation: standard MPM max |Δσ_yy|/ρgH", std_max, 0.0),
-        Check::report(case, "translation: uGIMP RMS Δσ_yy/ρgH while crossing cells", gimp_rms, 0.0),
+        Check::report(
+            case,
+            "translation: standard MPM RMS Δσ_yy/ρgH while crossing cells",
+            std_rms,
+            0.0,
+        ),
+        Check::report(
+            case,
+            "translation: standard MPM max |Δσ_yy|/ρgH",
+            std_max,
+            0.0,
+        ),
+        Check::report(
+            case,
+            "translation: uGIMP RMS Δσ_yy/ρgH while crossing cells",
+            gimp_rms,
+            0.0,
+        ),
         Check::report(case, "translation: uGIMP max |Δσ_yy|/ρgH", gimp_max, 0.0),
-        Check::report(case, "translation: RMS noise ratio standard / uGIMP", std_rms / gimp_rms, 10.0),
-        Check::report(case, "compaction: standard MPM RMS |σ_yy − σ_exact|/ρgH", cstd_rms, 0.0),
-        Check::report(case, "compaction: standard MPM max |σ_yy − σ_exact|/ρgH", cstd_max, 0.0),
-        Check::at_most(case, "compaction: uGIMP RMS |σ_yy − σ_exact|/ρgH", cgimp_rms, 0.02),
-        Check::report(case, "compaction: uGIMP max |σ_yy − σ_exact|/ρgH", cgimp_max, 0.0),
-        Check::at_least(case, "compaction: RMS error ratio standard / uGIMP", cstd_rms / cgimp_rms, 10.0),
+        Check::report(
+            case,
+            "translation: RMS noise ratio standard / uGIMP",
+            std_rms / gimp_rms,
+            10.0,
+        ),
+        Check::report(
+            case,
+            "compaction: standard MPM RMS |σ_yy − σ_exact|/ρgH",
+            cstd_rms,
+            0.0,
+        ),
+        Check::report(
+            case,
+            "compaction: standard MPM max |σ_yy − σ_exact|/ρgH",
+            cstd_max,
+            0.0,
+        ),
+        Check::at_most(
+            case,
+            "compaction: uGIMP RMS |σ_yy − σ_exact|/ρgH",
+            cgimp_rms,
+            0.02,
+        ),
+        Check::report(
+            case,
+            "compaction: uGIMP max |σ_yy − σ_exact|/ρgH",
+            cgimp_max,
+            0.0,
+        ),
+        Check::at_least(
+            case,
+            "compaction: RMS error ratio standard / uGIMP",
+            cstd_rms / cgimp_rms,
+            10.0,
+        ),
     ])
 }
 
@@ -304,10 +426,22 @@ pub fn conservation(fidelity: Fidelity) -> Result<Vec<Check>> {
             cohesion: 100.0,
             tension_cutoff: 50.0,
         });
-        let mut mpm = block(0.2, 0.1, h, 2, [8, 8, 8, 8], vec![], mat, params(ShapeKind::Gimp, scheme, 0.0, 0.0))?;
+        let mut mpm = block(
+            0.2,
+            0.1,
+            h,
+            2,
+            [8, 8, 8, 8],
+            vec![],
+            mat,
+            params(ShapeKind::Gimp, scheme, 0.0, 0.0),
+        )?;
         let (xc, yc) = (0.1, 0.05);
         for (v, x) in mpm.points.vel.iter_mut().zip(&mpm.points.pos) {
-            *v = [0.3 - 2.0 * (x[1] - yc) + 1.5 * x[1], 0.1 + 2.0 * (x[0] - xc)];
+            *v = [
+                0.3 - 2.0 * (x[1] - yc) + 1.5 * x[1],
+                0.1 + 2.0 * (x[0] - xc),
+            ];
         }
         let (m0, p0) = mpm.mass_momentum();
         mpm.steps(steps)?;
@@ -317,10 +451,30 @@ pub fn conservation(fidelity: Fidelity) -> Result<Vec<Check>> {
         let dp = ((p1[0] - p0[0]).powi(2) + (p1[1] - p0[1]).powi(2)).sqrt() / (m0 * vscale);
         let e = mpm.energy();
         let name = format!("{scheme:?}");
-        out.push(Check::at_most(case, &format!("{name}: |M_points(end) − M_points(0)|/M"), ((m1 - m0) / m0).abs(), 0.0));
-        out.push(Check::at_most(case, &format!("{name}: |M_nodes − M_points|/M"), ((mg - m1) / m1).abs(), 1e-13));
-        out.push(Check::at_most(case, &format!("{name}: |P(end) − P(0)| / (M·0.5 m/s) after {steps} steps"), dp, 1e-12));
-        out.push(Check::report(case, &format!("{name}: plastic dissipation / initial kinetic energy"), e.plastic / (0.5 * m0 * 0.25), 0.0));
+        out.push(Check::at_most(
+            case,
+            &format!("{name}: |M_points(end) − M_points(0)|/M"),
+            ((m1 - m0) / m0).abs(),
+            0.0,
+        ));
+        out.push(Check::at_most(
+            case,
+            &format!("{name}: |M_nodes − M_points|/M"),
+            ((mg - m1) / m1).abs(),
+            1e-13,
+        ));
+        out.push(Check::at_most(
+            case,
+            &format!("{name}: |P(end) − P(0)| / (M·0.5 m/s) after {steps} steps"),
+            dp,
+            1e-12,
+        ));
+        out.push(Check::report(
+            case,
+            &format!("{name}: plastic dissipation / initial kinetic energy"),
+            e.plastic / (0.5 * m0 * 0.25),
+            0.0,
+        ));
     }
     Ok(out)
 }

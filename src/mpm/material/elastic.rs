@@ -52,7 +52,13 @@ impl LinearElastic {
 }
 
 impl Material for LinearElastic {
-    fn update_stress(&self, stress: &Stress, de: &Strain, spin: f64, _: &mut MaterialState) -> Stress {
+    fn update_stress(
+        &self,
+        stress: &Stress,
+        de: &Strain,
+        spin: f64,
+        _: &mut MaterialState,
+    ) -> Stress {
         self.trial(stress, de, spin)
     }
     fn density(&self) -> f64 {

@@ -108,7 +108,9 @@ impl MohrCoulomb {
     /// Return a sorted principal trial stress σ_B (σ₁ ≥ σ₂ ≥ σ₃) to the admissible set.
     pub fn return_principal(&self, sb: &P3) -> (P3, Return) {
         let (k, m, sc) = (self.k(), self.m(), self.sigma_c());
-        let scale = sb.iter().fold(self.elastic.youngs_modulus * 1e-12, |a, v| a.max(v.abs()));
+        let scale = sb
+            .iter()
+            .fold(self.elastic.youngs_modulus * 1e-12, |a, v| a.max(v.abs()));
         let f = k * sb[0] - sb[2] - sc;
         let (mut s, mut kind) = if f <= 1e-14 * scale {
             (*sb, Return::Elastic)
@@ -130,10 +132,24 @@ impl MohrCoulomb {
             };
             if c[1] > c[0] + tol {
                 let (s, at_apex) = line([1.0, 1.0, k], [0.0, m, -1.0]);
-                (s, if at_apex { Return::Apex } else { Return::EdgeExtension })
+                (
+                    s,
+                    if at_apex {
+                        Return::Apex
+                    } else {
+                        Return::EdgeExtension
+                    },
+                )
             } else if c[2] > c[1] + tol {
                 let (s, at_apex) = line([1.0, k, k], [m, -1.0, 0.0]);
-                (s, if at_apex { Return::Apex } else { Return::EdgeCompression })
+                (
+                    s,
+                    if at_apex {
+                        Return::Apex
+                    } else {
+                        Return::EdgeCompression
+                    },
+                )
             } else {
                 (c, Return::Plane)
             }
@@ -141,7 +157,10 @@ impl MohrCoulomb {
         // Tension cut-off (Rankine) on whatever principal stresses exceed σ_t.
         let st = self.tension_cutoff.min(self.apex());
         if s[0] > st {
-            let (l, lg) = (self.elastic.lambda(), self.elastic.lambda() + 2.0 * self.elastic.shear_modulus());
+            let (l, lg) = (
+                self.elastic.lambda(),
+                self.elastic.lambda() + 2.0 * self.elastic.shear_modulus(),
+            );
             let n_over = s.iter().filter(|&&v| v > st).count();
             match n_over {
                 1 => {
@@ -178,7 +197,11 @@ impl MohrCoulomb {
         let p = 0.5 * (t[0] + t[1]);
         let q = 0.5 * (t[0] - t[1]);
         let r = (q * q + t[2] * t[2]).sqrt();
-        let (c2, s2) = if r > 0.0 { (q / r, t[2] / r) } else { (1.0, 0.0) };
+        let (c2, s2) = if r > 0.0 {
+            (q / r, t[2] / r)
+        } else {
+            (1.0, 0.0)
+        };
         let vals = [p + r, p - r, t[3]];
         // Sort descending, remembering the slot of each.
         let mut idx = [0usize, 1, 2];
@@ -218,7 +241,13 @@ impl MohrCoulomb {
 
 impl Material for MohrCoulomb {
     #[inline]
-    fn update_stress(&self, stress: &Stress, de: &Strain, spin: f64, state: &mut MaterialState) -> Stress {
+    fn update_stress(
+        &self,
+        stress: &Stress,
+        de: &Strain,
+        spin: f64,
+        state: &mut MaterialState,
+    ) -> Stress {
         self.update(stress, de, spin, state).0
     }
     fn density(&self) -> f64 {
@@ -272,7 +301,12 @@ mod tests {
     /// σ₃, σ₁ ≤ σ_t; all five regions are visited; elastic trials are unchanged.
     #[test]
     fn return_lands_on_the_yield_surface_in_order() {
-        for (phi, psi, c) in [(20.0, 0.0, 0.0), (30.0, 10.0, 1e4), (40.0, 0.0, 1e4), (35.0, 35.0, 5e3)] {
+        for (phi, psi, c) in [
+            (20.0, 0.0, 0.0),
+            (30.0, 10.0, 1e4),
+            (40.0, 0.0, 1e4),
+            (35.0, 35.0, 5e3),
+        ] {
             let m = mc(phi, psi, c, 1e9);
             let mut seen = std::collections::HashSet::new();
             for sb in trials(20000) {
@@ -281,7 +315,10 @@ mod tests {
                 let f = m.yield_function(&s);
                 let scale = 2e5;
                 assert!(f <= 1e-9 * scale, "{kind:?} f={f}");
-                assert!(s[0] >= s[1] - 1e-9 * scale && s[1] >= s[2] - 1e-9 * scale, "{kind:?} {s:?}");
+                assert!(
+                    s[0] >= s[1] - 1e-9 * scale && s[1] >= s[2] - 1e-9 * scale,
+                    "{kind:?} {s:?}"
+                );
                 assert!(s[0] <= m.apex() + 1e-9 * scale);
                 match kind {
                     Return::Elastic => assert_eq!(s, sb),
@@ -312,9 +349,14 @@ mod tests {
                 assert!(dot(&cr, &cr).sqrt() < 1e-9 * dot(&ds, &ds).sqrt() * dot(&db, &db).sqrt());
                 let e = &m.elastic;
                 let tr = ds[0] + ds[1] + ds[2];
-                let ep = ds.map(|v| ((1.0 + e.poisson_ratio) * v - e.poisson_ratio * tr) / e.youngs_modulus);
+                let ep = ds.map(|v| {
+                    ((1.0 + e.poisson_ratio) * v - e.poisson_ratio * tr) / e.youngs_modulus
+                });
                 let ratio = (ep[0] + ep[1] + ep[2]) / ep[0];
-                assert!((ratio - (m.m() - 1.0) / m.m()).abs() < 1e-9, "ψ={psi}: {ratio}");
+                assert!(
+                    (ratio - (m.m() - 1.0) / m.m()).abs() < 1e-9,
+                    "ψ={psi}: {ratio}"
+                );
             }
             assert!(n > 100);
         }
@@ -340,8 +382,15 @@ mod tests {
         let de = [1e-3, -2e-3, 5e-4];
         let (a, kind) = m.update(&s0, &de, 0.0, &mut MaterialState::default());
         assert_ne!(kind, Return::Elastic);
-        let (b, _) = m.update(&s0, &[de[1], de[0], de[2]], 0.0, &mut MaterialState::default());
-        assert!((a[0] - b[1]).abs() < 1e-6 && (a[1] - b[0]).abs() < 1e-6 && (a[2] - b[2]).abs() < 1e-6);
+        let (b, _) = m.update(
+            &s0,
+            &[de[1], de[0], de[2]],
+            0.0,
+            &mut MaterialState::default(),
+        );
+        assert!(
+            (a[0] - b[1]).abs() < 1e-6 && (a[1] - b[0]).abs() < 1e-6 && (a[2] - b[2]).abs() < 1e-6
+        );
         let p = |s: &Stress| {
             let q = 0.5 * (s[0] - s[1]);
             let r = (q * q + s[2] * s[2]).sqrt();

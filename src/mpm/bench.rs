@@ -85,6 +85,7 @@ pub fn column(n: usize, shape: ShapeKind) -> Result<Mpm> {
         courant: 0.5,
         dt: None,
         damping: 0.0,
+        pic_fraction: 0.0,
         resort_every: 20,
     };
     Mpm::new(grid, pts, material, params)

@@ -107,6 +107,9 @@ pub struct MpmSpec {
     pub courant: f64,
     /// Local damping α (0: none; a collapse should use 0).
     pub damping: f64,
+    /// PIC fraction β of the velocity update (0: pure FLIP), see
+    /// [`crate::mpm::MpmParams::pic_fraction`].
+    pub pic_fraction: f64,
     /// Re-sort the points into cell order every this many steps (performance only).
     pub resort_every: u64,
 }
@@ -395,6 +398,7 @@ impl MpmScenario {
             courant: self.mpm.courant,
             dt: self.time.dt,
             damping: self.mpm.damping,
+            pic_fraction: self.mpm.pic_fraction,
             resort_every: self.mpm.resort_every,
         };
         let mpm = Mpm::new(grid, pts, d.material, params)?;

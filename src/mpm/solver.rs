@@ -15,7 +15,8 @@
 //! * local non-viscous damping (Cundall), when α > 0: f_i ← f_i − α |f_i| sign(v_i) per
 //!   component (used only to reach static equilibrium, e.g. `mpm-selfweight`);
 //! * v_i^{n+1} = v_i + Δt f_i/m_i, then the walls ([`super::boundary`]);
-//! * FLIP velocity v_p ← v_p + Σ_i N_ip (v_i^{n+1} − v_i), position x_p ← x_p + Δt Σ_i N_ip v_i^{n+1};
+//! * FLIP velocity v_p ← v_p + Σ_i N_ip (v_i^{n+1} − v_i) (optionally blended with PIC,
+//!   [`MpmParams::pic_fraction`]), position x_p ← x_p + Δt Σ_i N_ip v_i^{n+1};
 //! * velocity gradient L = Σ_i v_i ⊗ ∇N_ip, Δε = Δt sym L, spin Δω = Δt ½(L_xy − L_yx),
 //!   F ← (I + Δt L) F, V = det F · V₀, σ ← material(σ, Δε, Δω).
 //!
@@ -70,6 +71,11 @@ pub struct MpmParams {
     pub dt: Option<f64>,
     /// Local damping coefficient α ∈ [0, 1) (0: none).
     pub damping: f64,
+    /// PIC fraction β ∈ [0, 1] of the point velocity update,
+    /// v_p ← (1 − β)(v_p + Σ N Δv_i) + β Σ N v_i^{n+1} (0: pure FLIP). PIC damps the
+    /// velocity modes the grid cannot see (the FLIP null space) and dissipates energy, which
+    /// then shows in the energy budget error; momentum stays exact either way.
+    pub pic_fraction: f64,
     /// Re-sort the points into cell order every this many steps.
     pub resort_every: u64,
 }
@@ -201,6 +207,12 @@ impl Mpm {
             return Err(Error::config(
                 "mpm.damping",
                 format!("must be in [0, 1), got {}", params.damping),
+            ));
+        }
+        if !(params.pic_fraction >= 0.0 && params.pic_fraction <= 1.0) {
+            return Err(Error::config(
+                "mpm.pic_fraction",
+                format!("must be in [0, 1], got {}", params.pic_fraction),
             ));
         }
         if grid.walls.len() > 8 {
@@ -507,6 +519,7 @@ impl Mpm {
         };
         let shape = self.params.shape;
         let dt = self.dt;
+        let pic = self.params.pic_fraction;
         let mat = &self.material;
         let do_v = matches!(
             pass,
@@ -550,7 +563,7 @@ impl Mpm {
                                 dv[0] += w * (vnew[n][0] - vold[n][0]);
                                 dv[1] += w * (vnew[n][1] - vold[n][1]);
                             }
-                            if do_x {
+                            if do_x || pic > 0.0 {
                                 xn[0] += w * vnew[n][0];
                                 xn[1] += w * vnew[n][1];
                             }
@@ -566,8 +579,9 @@ impl Mpm {
                         }
                     }
                     if do_v {
-                        vel[q][0] += dv[0];
-                        vel[q][1] += dv[1];
+                        // FLIP increment, blended with the PIC velocity Σ N v^{n+1}.
+                        vel[q][0] = (1.0 - pic) * (vel[q][0] + dv[0]) + pic * xn[0];
+                        vel[q][1] = (1.0 - pic) * (vel[q][1] + dv[1]) + pic * xn[1];
                     }
                     if do_s {
                         let f = fg[q];

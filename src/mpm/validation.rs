@@ -23,7 +23,7 @@
 //! * [`conservation`]: a free Mohr–Coulomb block with a rotating, shearing velocity field and
 //!   no gravity or walls: nodal mass = point mass to round-off, total momentum constant to
 //!   round-off (Σ_i ∇N_ip = 0 and Σ_i N_ip = 1 make the internal forces sum to zero), for USF,
-//!   USL and MUSL.
+//!   USL and MUSL, and MUSL with 5 % PIC.
 
 use super::boundary::{Side, Wall, WallKind};
 use super::grid::Grid;
@@ -82,6 +82,7 @@ fn params(shape: ShapeKind, scheme: Scheme, g: f64, damping: f64) -> MpmParams {
         courant: 0.5,
         dt: None,
         damping,
+        pic_fraction: 0.0,
         resort_every: 20,
     }
 }
@@ -417,7 +418,12 @@ pub fn conservation(fidelity: Fidelity) -> Result<Vec<Check>> {
         Fidelity::Full => 3000,
     };
     let mut out = Vec::new();
-    for scheme in [Scheme::Usf, Scheme::Usl, Scheme::Musl] {
+    for (scheme, pic) in [
+        (Scheme::Usf, 0.0),
+        (Scheme::Usl, 0.0),
+        (Scheme::Musl, 0.0),
+        (Scheme::Musl, 0.05),
+    ] {
         let h = 0.02;
         let mat = MaterialModel::MohrCoulomb(MohrCoulomb {
             elastic: elastic(1800.0, 1e6, 0.25),
@@ -434,7 +440,10 @@ pub fn conservation(fidelity: Fidelity) -> Result<Vec<Check>> {
             [8, 8, 8, 8],
             vec![],
             mat,
-            params(ShapeKind::Gimp, scheme, 0.0, 0.0),
+            MpmParams {
+                pic_fraction: pic,
+                ..params(ShapeKind::Gimp, scheme, 0.0, 0.0)
+            },
         )?;
         let (xc, yc) = (0.1, 0.05);
         for (v, x) in mpm.points.vel.iter_mut().zip(&mpm.points.pos) {
@@ -450,7 +459,7 @@ pub fn conservation(fidelity: Fidelity) -> Result<Vec<Check>> {
         let vscale = 0.5;
         let dp = ((p1[0] - p0[0]).powi(2) + (p1[1] - p0[1]).powi(2)).sqrt() / (m0 * vscale);
         let e = mpm.energy();
-        let name = format!("{scheme:?}");
+        let name = format!("{scheme:?} (PIC fraction {pic})");
         out.push(Check::at_most(
             case,
             &format!("{name}: |M_points(end) − M_points(0)|/M"),

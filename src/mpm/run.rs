@@ -322,9 +322,16 @@ pub fn run_column_collapse(
     let (mut rest_since, mut at_rest) = (None::<f64>, false);
     let (mut row, mut frame) = (0u64, 0usize);
     let t_run = Instant::now();
-    // Relative to the booked dissipation (floored at 1e-12 E_0 so t = 0 reads 0, not 0/0).
-    let floor = 1e-12 * e0.total().abs().max(1e-300);
-    let budget = |e: &MpmEnergy| (e.total() - e0.total()).abs() / e.dissipated().max(floor);
+    // Relative to the booked dissipation; 0 while almost nothing is dissipated (t ≈ 0, where
+    // the ratio would be round-off over round-off).
+    let tiny = 1e-9 * e0.total().abs();
+    let budget = |e: &MpmEnergy| {
+        if e.dissipated() > tiny {
+            (e.total() - e0.total()).abs() / e.dissipated()
+        } else {
+            0.0
+        }
+    };
     let mut last;
     loop {
         let e = mpm.energy();

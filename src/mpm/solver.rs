@@ -140,10 +140,13 @@ pub struct Mpm {
     perm: Vec<u32>,
     scratch: PermuteScratch,
     mass_eps: f64,
+    /// Each point's stencil at the start of the step (computed once in `bin`, used by every
+    /// pass of the step: the positions move only at the end of the last pass).
+    stencils: Vec<Stencil>,
 }
 
 /// Stencil of a point: first node (i, j) and 1-D weights and derivatives.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug, Default)]
 struct Stencil {
     i0: i64,
     j0: i64,
@@ -256,6 +259,7 @@ impl Mpm {
             perm: Vec::with_capacity(n),
             scratch: PermuteScratch::default(),
             mass_eps,
+            stencils: vec![Stencil::default(); n],
         };
         // The stress work starts at the initial elastic energy (so plastic = work − elastic).
         for p in 0..n {
@@ -328,14 +332,13 @@ impl Mpm {
         let shape = self.params.shape;
         let ns = self.stripe_start.len() - 1;
         self.stripe_start.iter_mut().for_each(|c| *c = 0);
-        for (p, (&x, &lp)) in self
-            .points
-            .pos
-            .iter()
-            .zip(&self.points.half_size)
-            .enumerate()
-        {
-            let st = stencil(shape, g.origin, g.h, x, lp);
+        let (origin, h) = (g.origin, g.h);
+        self.stencils
+            .par_iter_mut()
+            .zip(self.points.pos.par_iter())
+            .zip(self.points.half_size.par_iter())
+            .for_each(|((st, &x), &lp)| *st = stencil(shape, origin, h, x, lp));
+        for (p, (&x, st)) in self.points.pos.iter().zip(&self.stencils).enumerate() {
             let ok = x[0].is_finite()
                 && x[1].is_finite()
                 && st.i0 >= 0
@@ -382,11 +385,11 @@ impl Mpm {
     /// gravity force; `momentum`: momentum only (MUSL re-map; mass kept).
     fn p2g(&mut self, mass: bool, force: bool, momentum: bool) {
         let g = &mut self.grid;
-        let (nny, h, origin) = (g.ny + 1, g.h, g.origin);
+        let nny = g.ny + 1;
         let pts = &self.points;
-        let shape = self.params.shape;
         let grav = self.params.gravity;
         let (order, starts) = (&self.order, &self.stripe_start);
+        let stencils = &self.stencils;
         let ns = starts.len() - 1;
         g.sums.par_iter_mut().for_each(|s| {
             if mass {
@@ -415,7 +418,7 @@ impl Mpm {
                     let col0 = (s * STRIPE) as i64;
                     for &q in &order[starts[s]..starts[s + 1]] {
                         let q = q as usize;
-                        let st = stencil(shape, origin, h, pts.pos[q], pts.half_size[q]);
+                        let st = &stencils[q];
                         let m = pts.mass[q];
                         let v = pts.vel[q];
                         let vol = pts.vol[q];
@@ -517,7 +520,6 @@ impl Mpm {
             PointPass::All => &g.vel_new,
             _ => &g.vel_map,
         };
-        let shape = self.params.shape;
         let dt = self.dt;
         let pic = self.params.pic_fraction;
         let mat = &self.material;
@@ -533,6 +535,7 @@ impl Mpm {
             pass,
             PointPass::All | PointPass::StressFromMap | PointPass::StressFromMapAndMove
         );
+        let stencils = &self.stencils;
         let p = &mut self.points;
         let bad = (
             p.pos.par_chunks_mut(CHUNK),
@@ -543,14 +546,14 @@ impl Mpm {
             p.state.par_chunks_mut(CHUNK),
             p.work.par_chunks_mut(CHUNK),
             p.vol0.par_chunks(CHUNK),
-            p.half_size.par_chunks(CHUNK),
+            stencils.par_chunks(CHUNK),
         )
             .into_par_iter()
             .enumerate()
-            .map(|(k, (pos, vel, fg, vol, sig, state, work, vol0, lp))| {
+            .map(|(k, (pos, vel, fg, vol, sig, state, work, vol0, sts))| {
                 let mut bad = None;
                 for q in 0..pos.len() {
-                    let st = stencil(shape, origin, h, pos[q], lp[q]);
+                    let st = &sts[q];
                     let mut dv = [0.0; 2];
                     let mut xn = [0.0; 2];
                     let mut l = [0.0; 4];

@@ -153,3 +153,44 @@ fn short_collapse_writes_the_output_contract() {
         r.potential_initial
     );
 }
+
+/// The `Scale` verbs: `advance(dt)` sub-cycles ⌈dt/Δt⌉ steps and lands on t + dt; a snapshot
+/// restores the state exactly.
+#[test]
+fn scale_advances_in_substeps_and_restores() {
+    use granflow::scale::Scale;
+    let mut mpm = granflow::mpm::bench::column(512, granflow::mpm::ShapeKind::Gimp).unwrap();
+    let dt = mpm.max_dt();
+    let snap = mpm.snapshot();
+    mpm.advance(&(), 10.5 * dt).unwrap();
+    assert_eq!(mpm.step_count(), 11);
+    assert!((Scale::time(&mpm) - 10.5 * dt).abs() < 1e-12 * dt);
+    let moved = mpm.points.pos.clone();
+    mpm.restore(snap);
+    assert_eq!(Scale::time(&mpm), 0.0);
+    assert_ne!(mpm.points.pos, moved);
+    let mut view = granflow::mpm::scale::PointView::default();
+    mpm.observe(&mut view);
+    assert_eq!(view.pos.len(), mpm.points.len());
+}
+
+/// Attachment: a point more than one cell away from the main mass is not part of the run-out
+/// but is the front; a point in a cell touching the mass is attached.
+#[test]
+fn runout_counts_only_points_attached_to_the_main_mass() {
+    let mut mpm = granflow::mpm::bench::column(512, granflow::mpm::ShapeKind::Gimp).unwrap();
+    let h = mpm.grid.h;
+    let s0 = granflow::mpm::run::shape(&mpm);
+    let right = mpm.points.pos.iter().fold(0.0f64, |a, p| a.max(p[0]));
+    // Two cells beyond the mass's last occupied cell: detached.
+    mpm.points.pos.push([right + 2.5 * h, 0.25 * h]);
+    mpm.points.half_size.push(0.25 * h);
+    let s1 = granflow::mpm::run::shape(&mpm);
+    assert_eq!(s1.runout, s0.runout);
+    assert!((s1.front - (right + 2.75 * h)).abs() < 1e-12);
+    // One cell beyond: its cell shares an edge with an occupied cell, so attached.
+    mpm.points.pos.push([right + 1.0 * h, 0.25 * h]);
+    mpm.points.half_size.push(0.25 * h);
+    let s2 = granflow::mpm::run::shape(&mpm);
+    assert!((s2.runout - (right + 1.25 * h)).abs() < 1e-12, "{s2:?}");
+}

@@ -194,3 +194,9 @@ fn runout_counts_only_points_attached_to_the_main_mass() {
     let s2 = granflow::mpm::run::shape(&mpm);
     assert!((s2.runout - (right + 1.25 * h)).abs() < 1e-12, "{s2:?}");
 }
+
+/// Coulomb wall: a sliding block decelerates at μg (rigid-body reference).
+#[test]
+fn mpm_friction_sliding_block() {
+    case_passes("mpm-friction");
+}

@@ -24,6 +24,8 @@
 //!   no gravity or walls: nodal mass = point mass to round-off, total momentum constant to
 //!   round-off (Σ_i ∇N_ip = 0 and Σ_i N_ip = 1 make the internal forces sum to zero), for USF,
 //!   USL and MUSL, and MUSL with 5 % PIC.
+//! * [`sliding_block`] (`mpm-friction`): a block sliding on a Coulomb-frictional floor
+//!   decelerates at μg (rigid-body reference, 3 %).
 
 use super::boundary::{Side, Wall, WallKind};
 use super::grid::Grid;
@@ -486,4 +488,74 @@ pub fn conservation(fidelity: Fidelity) -> Result<Vec<Check>> {
         ));
     }
     Ok(out)
+}
+
+/// A block sliding on a Coulomb-frictional floor (μ = 0.3) from v₀ = 0.5 m/s after settling
+/// under gravity: rigid-body mechanics gives the deceleration μg, so the centre-of-mass
+/// velocity v₀ − μgt at t = 0.1 s and the sliding distance v₀²/(2μg). Tolerance 3 % (the
+/// block is elastic and rings a little as it is released; the wall acts on grid nodes).
+pub fn sliding_block(_: Fidelity) -> Result<Vec<Check>> {
+    let case = "mpm-friction";
+    let (rho, g, h, mu, v0) = (1000.0, 9.81, 0.02, 0.3, 0.5);
+    let walls = vec![Wall {
+        side: Side::Bottom,
+        position: 0.0,
+        kind: WallKind::Friction { mu },
+    }];
+    let mat = MaterialModel::Elastic(elastic(rho, 1e6, 0.3));
+    let mut mpm = block(
+        0.2,
+        0.1,
+        h,
+        2,
+        [2, 6, 2, 3],
+        walls,
+        mat,
+        params(ShapeKind::Gimp, Scheme::Musl, g, 0.3),
+    )?;
+    mpm.steps((0.5 / mpm.dt()).ceil() as u64)?;
+    mpm.params.damping = 0.0;
+    for v in mpm.points.vel.iter_mut() {
+        *v = [v0, 0.0];
+    }
+    let com = |m: &Mpm| {
+        let (mut mx, mut mv, mut mt) = (0.0, 0.0, 0.0);
+        for q in 0..m.points.len() {
+            mx += m.points.mass[q] * m.points.pos[q][0];
+            mv += m.points.mass[q] * m.points.vel[q][0];
+            mt += m.points.mass[q];
+        }
+        (mx / mt, mv / mt)
+    };
+    let (x0, _) = com(&mpm);
+    let t1 = 0.1;
+    let n1 = (t1 / mpm.dt()).round() as u64;
+    mpm.steps(n1)?;
+    let t1 = n1 as f64 * mpm.dt();
+    let (_, v1) = com(&mpm);
+    let stop = v0 / (mu * g);
+    mpm.steps(((stop + 0.1) / mpm.dt()).ceil() as u64 - n1)?;
+    let (x2, v2) = com(&mpm);
+    Ok(vec![
+        Check::rel(
+            case,
+            "centre-of-mass velocity at t = 0.1 s (m/s)",
+            v1,
+            v0 - mu * g * t1,
+            0.03,
+        ),
+        Check::rel(
+            case,
+            "sliding distance (m)",
+            x2 - x0,
+            v0 * v0 / (2.0 * mu * g),
+            0.03,
+        ),
+        Check::at_most(
+            case,
+            "|velocity| 0.1 s after the analytic stop (m/s)",
+            v2.abs(),
+            0.01,
+        ),
+    ])
 }

@@ -326,6 +326,11 @@ pub const CASES: &[Case] = &[
         description: "MPM mass exact, momentum to round-off (USF, USL, MUSL)",
         run: |f| checks_only(crate::mpm::validation::conservation(f)),
     },
+    Case {
+        name: "mpm-friction",
+        description: "block sliding on a Coulomb wall: deceleration μg, distance v₀²/(2μg)",
+        run: |f| checks_only(crate::mpm::validation::sliding_block(f)),
+    },
 ];
 
 /// A report of checks without figures.

@@ -43,7 +43,8 @@ pub struct LbmBench {
     pub samples: Vec<f64>,
 }
 
-fn median(v: &mut [f64]) -> f64 {
+/// Median of `v` (sorted in place).
+pub fn median(v: &mut [f64]) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
     v[v.len() / 2]
 }

@@ -120,6 +120,24 @@ enum Bench {
         #[arg(long)]
         json: bool,
     },
+    /// DEM: the LAMMPS `in.gran2d.lmp` case (hex block of disks collapsing between walls).
+    Dem {
+        /// Number of grains (a √N × √N hex block).
+        #[arg(long, default_value_t = 10_000)]
+        grains: usize,
+        /// Timed steps per repeat (after 500 warm-up steps).
+        #[arg(long, default_value_t = 5000)]
+        steps: u64,
+        /// Threads (0: all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Repeats (each a fresh block); the median is reported.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -357,12 +375,13 @@ fn run_dem(path: &Path, out: &Path) -> Result<ExitCode> {
     })
     .with_context(|| stopped(path, out))?;
     println!(
-        "done: a = {:.3}, L_f/L_i − 1 = {:.3}, H_f/L_i = {:.3}, stop at {:.2} τ_c ({}), {} grains, packing {:.3}",
+        "done: a = {:.3}, L_f/L_i − 1 = {:.3}, H_f/L_i = {:.3}, spreading stopped at {:.2} τ_c, {} at {:.2} τ_c, {} grains, packing {:.3}",
         r.aspect_ratio,
         r.delta_l,
         r.h_f_over_l_i,
         r.stop_time_tc,
         if r.at_rest { "at rest" } else { "end time reached" },
+        r.rest_time_tc,
         r.grains,
         r.packing_fraction
     );
@@ -535,6 +554,26 @@ fn bench(which: Bench) -> Result<ExitCode> {
                 println!(
                     "lbm {}×{} {} {} on {} threads: {:.1} MLUPS (samples {:?}); copy {:.1} GB/s; {} B/cell; {:.0} % of roofline",
                     r.nx, r.ny, r.precision, r.collision, r.threads, r.mlups, r.samples.iter().map(|s| (s * 10.0).round() / 10.0).collect::<Vec<_>>(), r.copy_gb_s, r.bytes_per_cell, 100.0 * r.roofline_fraction
+                );
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Bench::Dem {
+            grains,
+            steps,
+            threads,
+            repeats,
+            json,
+        } => {
+            let r = granflow::dem::bench::run(grains, steps, threads, repeats)?;
+            if json {
+                println!("{}", serde_json::to_string(&r)?);
+            } else {
+                println!(
+                    "dem {} grains, {} steps on {} threads: {:.3e} particle-steps/s (samples {:?}); {:.0} contacts/step; {:.3} list builds/step",
+                    r.grains, r.steps, r.threads, r.particle_steps_per_s,
+                    r.samples.iter().map(|s| format!("{s:.3e}")).collect::<Vec<_>>(),
+                    r.contacts_per_step, r.list_builds_per_step
                 );
             }
             Ok(ExitCode::SUCCESS)

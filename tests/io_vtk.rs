@@ -171,10 +171,14 @@ fn vtu_vertices_round_trip_through_vtkio() {
     let points = [[0.0, 0.0], [1.0, 0.1], [2.0, -0.3]];
     let radius = [0.5, 0.25, 0.125];
     let id = [0.0, 1.0, 2.0];
+    let stress = [[1.0, 2.0, 3.0, 4.0], [-1e5, 0.5, 0.25, 1.0 / 3.0], [0.0; 4]];
     write_vtu_points(
         &path,
         &points,
-        &[Field::scalar("radius", &radius)],
+        &[
+            Field::scalar("radius", &radius),
+            Field::tensor("stress", &stress),
+        ],
         &[],
         &[Field::scalar("id", &id)],
     )
@@ -194,6 +198,14 @@ fn vtu_vertices_round_trip_through_vtkio() {
         v => panic!("{v:?}"),
     }
     assert_eq!(array(&piece.data.point, "radius").1, radius);
+    // 2 × 2 tensors come back as 3 × 3 with a zero z row and column.
+    let (elem, got) = array(&piece.data.point, "stress");
+    assert_eq!(elem, ElementType::Tensors);
+    let want: Vec<f64> = stress
+        .iter()
+        .flat_map(|&[a, b, c, d]| [a, b, 0.0, c, d, 0.0, 0.0, 0.0, 0.0])
+        .collect();
+    assert_eq!(got, want);
     assert_eq!(array(&piece.data.cell, "id").1, id);
     keep(dir.path());
 }

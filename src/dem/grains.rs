@@ -4,7 +4,9 @@
 //! mass unit otherwise) with moment of inertia J = ½ m R² (solid disk). The equations of motion
 //! are seed eq. 5.55–5.57: m a = F_c + F_f + m g − c v, J θ̈ = T_c + T_f.
 
-/// Disk grains, structure of arrays.
+use super::shape::{Polygons, DISK};
+
+/// Grains (disks or convex polygons), structure of arrays.
 #[derive(Clone, Debug, Default)]
 pub struct Grains {
     /// Centre x (m).
@@ -31,6 +33,10 @@ pub struct Grains {
     pub fy: Vec<f64>,
     /// Total torque of the last force evaluation.
     pub torque: Vec<f64>,
+    /// Shape of each grain: [`DISK`] or an index into [`Grains::polygons`].
+    pub shape: Vec<u32>,
+    /// Shared table of polygon shapes (empty for an all-disk system).
+    pub polygons: Polygons,
 }
 
 impl Grains {
@@ -55,6 +61,8 @@ impl Grains {
             fx: v(),
             fy: v(),
             torque: v(),
+            shape: Vec::with_capacity(n),
+            polygons: Polygons::default(),
         }
     }
 
@@ -83,7 +91,36 @@ impl Grains {
         self.fx.push(0.0);
         self.fy.push(0.0);
         self.torque.push(0.0);
+        self.shape.push(DISK);
         self.x.len() - 1
+    }
+
+    /// Append a convex polygon grain of shape `s` (index into [`Grains::polygons`]) with its
+    /// centroid at (x, y), rotated by `angle`, of areal density `rho`: m = ρA, J = ρJ_A,
+    /// R = bounding radius. Returns its index.
+    pub fn push_polygon(&mut self, x: f64, y: f64, angle: f64, s: u32, rho: f64) -> usize {
+        let p = &self.polygons;
+        let (m, j, r) = (
+            rho * p.area[s as usize],
+            rho * p.polar[s as usize],
+            p.bound[s as usize],
+        );
+        let i = self.push(x, y, r, m);
+        self.inertia[i] = j;
+        self.angle[i] = angle;
+        self.shape[i] = s;
+        i
+    }
+
+    /// Whether grain `i` is a disk.
+    #[inline(always)]
+    pub fn is_disk(&self, i: usize) -> bool {
+        self.shape.get(i).is_none_or(|&s| s == DISK)
+    }
+
+    /// Whether some grain is a polygon.
+    pub fn has_polygons(&self) -> bool {
+        self.shape.iter().any(|&s| s != DISK)
     }
 
     /// Append a disk of areal density `rho` (mass per unit area, so m = ρ π r²).
@@ -116,11 +153,16 @@ impl Grains {
         p
     }
 
-    /// Total grain area Σ π R².
+    /// Total grain area: Σ π R² over disks plus the polygons' areas.
     pub fn area(&self) -> f64 {
-        self.radius
-            .iter()
-            .map(|r| std::f64::consts::PI * r * r)
+        (0..self.len())
+            .map(|i| {
+                if self.is_disk(i) {
+                    std::f64::consts::PI * self.radius[i] * self.radius[i]
+                } else {
+                    self.polygons.area[self.shape[i] as usize]
+                }
+            })
             .sum()
     }
 }

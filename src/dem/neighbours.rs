@@ -30,8 +30,13 @@ pub struct PairList {
     /// Contact state of each pair: last overlap, springs, forces (see [`ContactState`]).
     pub state: Vec<ContactState>,
     /// Forces of each pair applied in the last second half-kick: [F_x on i, F_y on i,
-    /// torque on i, torque on j] (the force on j is the opposite).
+    /// torque on i, torque on j] (the force on j is the opposite); valid where `flags` has
+    /// [`PAIR_ACTIVE`] (pairs apart before and after the step are skipped, `out` left stale).
     pub out: Vec<[f64; 4]>,
+    /// Per pair: [`PAIR_ACTIVE`] if `out` holds this evaluation's force, [`PAIR_TOUCHING`] if
+    /// the grains overlapped at the last evaluation (the same as `state[p].touching()`, kept in
+    /// one byte so the force loop skips the many apart pairs without loading their state).
+    pub flags: Vec<u8>,
     /// Pairs whose first grain is `g` are `first[g]..first[g + 1]`.
     pub first: Vec<u32>,
     /// Pairs whose second grain is `g` are `as_j[j_start[g]..j_start[g + 1]]`.
@@ -39,6 +44,11 @@ pub struct PairList {
     /// Pair indices grouped by second grain.
     pub as_j: Vec<u32>,
 }
+
+/// [`PairList::flags`] bit: `out` holds this evaluation's force.
+pub const PAIR_ACTIVE: u8 = 1;
+/// [`PairList::flags`] bit: the grains overlapped at the last evaluation.
+pub const PAIR_TOUCHING: u8 = 2;
 
 /// Grain–wall pairs within reach, sorted by (grain, wall).
 #[derive(Clone, Debug, Default)]
@@ -98,6 +108,12 @@ impl Detector {
                 let r2 = dx * dx + dy * dy;
                 r2 > lim || r2.is_nan()
             })
+    }
+
+    /// Positions at the last build and the squared displacement (skin/2)² beyond which the
+    /// list must be rebuilt (empty slices before the first build).
+    pub fn reference(&self) -> (&[f64], &[f64], f64) {
+        (&self.x_ref, &self.y_ref, 0.25 * self.skin * self.skin)
     }
 
     /// Rebuild both lists from the current positions, carrying history over.
@@ -177,13 +193,15 @@ impl Detector {
         let nchunks = n.div_ceil(CHUNK).max(1);
         self.bufs.resize_with(nchunks, Vec::new);
         let (cell_start, sorted, cell_of) = (&self.cell_start, &self.sorted, &self.cell_of);
+        // Pairs with a polygon grain belong to the rapier detector (`detect_rapier`).
+        let polys = g.has_polygons();
         self.bufs.par_iter_mut().enumerate().for_each(|(k, buf)| {
             buf.clear();
             let mut mine: Vec<u32> = Vec::with_capacity(16);
             #[allow(clippy::needless_range_loop)]
             for i in k * CHUNK..((k + 1) * CHUNK).min(n) {
                 let c = cell_of[i];
-                if c == u32::MAX {
+                if c == u32::MAX || (polys && !g.is_disk(i)) {
                     continue;
                 }
                 let (cx, cy) = ((c as usize) % ncx, (c as usize) / ncx);
@@ -193,7 +211,7 @@ impl Detector {
                     for nx in cx.saturating_sub(1)..=(cx + 1).min(ncx - 1) {
                         let cc = ny * ncx + nx;
                         for &j in &sorted[cell_start[cc] as usize..cell_start[cc + 1] as usize] {
-                            if j as usize <= i {
+                            if j as usize <= i || (polys && !g.is_disk(j as usize)) {
                                 continue;
                             }
                             let j_ = j as usize;
@@ -238,6 +256,12 @@ impl Detector {
         }
         pl.out.clear();
         pl.out.resize(m, [0.0; 4]);
+        pl.flags.clear();
+        pl.flags.extend(
+            pl.state
+                .iter()
+                .map(|s| if s.touching() { PAIR_TOUCHING } else { 0 }),
+        );
         // Index by first grain.
         pl.first.clear();
         pl.first.resize(n + 1, 0);
@@ -277,6 +301,9 @@ impl Detector {
         wl.first.resize(n + 1, 0);
         let mut o = 0;
         for k in 0..n {
+            // Polygon grains meet walls through the rapier detector; polygon walls report
+            // s = ∞ and are never paired here.
+            let walls = if g.is_disk(k) { walls } else { &[] };
             for (w, wall) in walls.iter().enumerate() {
                 let (s, _) = wall.distance([g.x[k], g.y[k]]);
                 if s < g.radius[k] + self.skin {

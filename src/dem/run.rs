@@ -2,20 +2,29 @@
 //! integrate until the mass is at rest, and write
 //!
 //! * `series.pvd` with, per frame, `grains_NNNNNN.vtu` (part 0: points with radius, velocity,
-//!   angular velocity, contact count) and `contacts_NNNNNN.vtu` (part 1: a line cell per
-//!   touching grain–grain pair joining the two centres, with the normal and tangential force
-//!   magnitudes f_n, f_t — force chains in ParaView);
+//!   angular velocity, contact count, Love–Weber stress tensor and its mean −(σ_xx + σ_yy)/2,
+//!   see [`super::stress`]) and `contacts_NNNNNN.vtu` (part 1: a line cell per touching pair —
+//!   grain–grain from centre to centre, grain–wall from the centre to the contact point on
+//!   the wall — with the normal and tangential forces f_n, f_t and `wall` = 1 for wall
+//!   contacts: force chains in ParaView);
 //! * `timeseries.csv`: t, t/τ_c, run-out, front, height, energies, budget error;
 //! * `summary.json` ([`CollapseSummary`]).
 //!
 //! Definitions (REFERENCES, granular column collapse): τ_c = √(H_i/g) with H_i the deposited
-//! height; the *main mass* is the largest set of grains connected through touching contacts;
-//! the run-out L(t) is the largest x + R over the main mass (the thesis: the farthest grain
-//! still in contact with the main mass), measured from the left wall; the front is the largest
-//! x + R over all grains; the height H(t) is the largest y + R over the main mass. At rest:
-//! L_f, H_f, ΔL = (L_f − L_i)/L_i, H_f/L_i. The run stops when the kinetic energy has stayed
-//! below `rest_kinetic_fraction` × the initial potential energy above the floor for
-//! `rest_duration_tc` τ_c (and t ≥ 1 τ_c), or at `end_tc` τ_c.
+//! height; the *main mass* is the largest set of grains connected through near-contacts, two
+//! grains being connected when their gap is below [`CONNECT_GAP`] × (R_i + R_j) (at rest this
+//! is the thesis's "in contact with the main mass"; during the flow the small tolerance keeps
+//! the agitated mass from falling apart into clusters at every bounce, which made the
+//! run-out flicker with a strict-contact rule); the run-out L(t) is the largest x + R over
+//! the main mass (the thesis: the farthest grain still in contact with the main mass),
+//! measured from the left wall; the front is the largest x + R over all grains (it includes
+//! single grains rolling away); the height H(t) is the largest y + R over the main mass. At
+//! rest: L_f, H_f, ΔL = (L_f − L_i)/L_i, H_f/L_i. The *stop time* is when spreading ends:
+//! the first time after which L(t) stays within [`STOP_TOLERANCE`] × L_i of L_f. The run
+//! ends when the kinetic energy has stayed below `rest_kinetic_fraction` × the initial
+//! potential energy above the floor for `rest_duration_tc` τ_c (and t ≥ 1 τ_c; reported as
+//! `rest_time_tc`, which also waits for grains rolling away from the deposit), or at
+//! `end_tc` τ_c.
 
 use std::path::Path;
 use std::time::Instant;
@@ -25,9 +34,16 @@ use serde::Serialize;
 use super::packing::deposit_column;
 use super::scenario::DemScenario;
 use super::solver::Dem;
+use super::stress::grain_stress;
 use super::walls::Wall;
 use crate::io::{write_json, write_vtu_points, CsvWriter, Field, PvdSeries};
 use crate::{Error, Result};
+
+/// Two grains belong to the same mass when their gap is below this fraction of R_i + R_j.
+pub const CONNECT_GAP: f64 = 0.1;
+
+/// Spreading has stopped once the run-out stays within this fraction of L_i of its final value.
+pub const STOP_TOLERANCE: f64 = 0.01;
 
 /// What a collapse run reports (`summary.json`).
 #[derive(Clone, Debug, Serialize)]
@@ -54,8 +70,11 @@ pub struct CollapseSummary {
     pub delta_l: f64,
     /// H_f/L_i.
     pub h_f_over_l_i: f64,
-    /// Time at which the mass came to rest (start of the rest interval), in τ_c.
+    /// End of spreading, in τ_c: from then on the run-out stays within [`STOP_TOLERANCE`] L_i
+    /// of L_f.
     pub stop_time_tc: f64,
+    /// Start of the final rest interval (kinetic-energy criterion), in τ_c.
+    pub rest_time_tc: f64,
     /// Whether the run stopped at rest (false: it reached `end_tc`).
     pub at_rest: bool,
     /// Time step (s).
@@ -89,7 +108,9 @@ fn find(parent: &mut [u32], mut a: u32) -> u32 {
     a
 }
 
-/// Measure the deposit shape (see the module doc) from the touching grain–grain pairs.
+/// Measure the deposit shape (see the module doc): main mass by near-contacts found on a
+/// uniform grid of cells 2R_max(1 + [`CONNECT_GAP`]) wide, contact counts from the touching
+/// pairs.
 fn shape(dem: &Dem) -> Shape {
     let g = &dem.grains;
     let n = g.len();
@@ -98,19 +119,61 @@ fn shape(dem: &Dem) -> Shape {
     let pl = dem.pairs();
     for k in 0..pl.i.len() {
         if pl.state[k].touching() {
-            let (i, j) = (pl.i[k], pl.j[k]);
-            contacts[i as usize] += 1.0;
-            contacts[j as usize] += 1.0;
-            let (a, b) = (find(&mut parent, i), find(&mut parent, j));
-            if a != b {
-                parent[a as usize] = b;
-            }
+            contacts[pl.i[k] as usize] += 1.0;
+            contacts[pl.j[k] as usize] += 1.0;
         }
     }
     let wl = dem.wall_pairs();
     for k in 0..wl.grain.len() {
         if wl.state[k].touching() {
             contacts[wl.grain[k] as usize] += 1.0;
+        }
+    }
+    // Near-contact graph on a cell grid over the grains' bounding box.
+    let h = 2.0 * g.max_radius() * (1.0 + CONNECT_GAP);
+    let (x0, y0) = (
+        g.x.iter().fold(f64::INFINITY, |a, &b| a.min(b)),
+        g.y.iter().fold(f64::INFINITY, |a, &b| a.min(b)),
+    );
+    let cell = |i: usize| (((g.x[i] - x0) / h) as usize, ((g.y[i] - y0) / h) as usize);
+    let ncx = (0..n).map(|i| cell(i).0).max().unwrap_or(0) + 1;
+    let ncy = (0..n).map(|i| cell(i).1).max().unwrap_or(0) + 1;
+    let mut start = vec![0u32; ncx * ncy + 1];
+    for i in 0..n {
+        let (cx, cy) = cell(i);
+        start[cy * ncx + cx + 1] += 1;
+    }
+    for c in 0..ncx * ncy {
+        start[c + 1] += start[c];
+    }
+    let mut fill = start.clone();
+    let mut sorted = vec![0u32; n];
+    for i in 0..n {
+        let (cx, cy) = cell(i);
+        let c = cy * ncx + cx;
+        sorted[fill[c] as usize] = i as u32;
+        fill[c] += 1;
+    }
+    for i in 0..n {
+        let (cx, cy) = cell(i);
+        for ny in cy.saturating_sub(1)..=(cy + 1).min(ncy - 1) {
+            for nx in cx.saturating_sub(1)..=(cx + 1).min(ncx - 1) {
+                let c = ny * ncx + nx;
+                for &j in &sorted[start[c] as usize..start[c + 1] as usize] {
+                    let j_ = j as usize;
+                    if j_ <= i {
+                        continue;
+                    }
+                    let reach = (g.radius[i] + g.radius[j_]) * (1.0 + CONNECT_GAP);
+                    let (dx, dy) = (g.x[j_] - g.x[i], g.y[j_] - g.y[i]);
+                    if dx * dx + dy * dy < reach * reach {
+                        let (a, b) = (find(&mut parent, i as u32), find(&mut parent, j));
+                        if a != b {
+                            parent[a as usize] = b;
+                        }
+                    }
+                }
+            }
         }
     }
     let mut size = vec![0u32; n];
@@ -136,11 +199,34 @@ fn shape(dem: &Dem) -> Shape {
     }
 }
 
-fn write_frame(dem: &Dem, s: &Shape, dir: &Path, k: usize, pvd: &mut PvdSeries) -> Result<()> {
+/// End of spreading: the first time after which every run-out in `history` (t, L) stays
+/// within `tol` of the last one.
+fn spreading_end(history: &[(f64, f64)], tol: f64) -> f64 {
+    let Some(&(t_end, l_f)) = history.last() else {
+        return 0.0;
+    };
+    history
+        .iter()
+        .rev()
+        .take_while(|&&(_, l)| (l - l_f).abs() <= tol)
+        .last()
+        .map_or(t_end, |&(t, _)| t)
+}
+
+fn write_frame(
+    dem: &Dem,
+    s: &Shape,
+    thickness: f64,
+    dir: &Path,
+    k: usize,
+    pvd: &mut PvdSeries,
+) -> Result<()> {
     let g = &dem.grains;
     let n = g.len();
-    let points: Vec<[f64; 2]> = (0..n).map(|i| [g.x[i], g.y[i]]).collect();
+    let mut points: Vec<[f64; 2]> = (0..n).map(|i| [g.x[i], g.y[i]]).collect();
     let vel: Vec<[f64; 2]> = (0..n).map(|i| [g.vx[i], g.vy[i]]).collect();
+    let stress = grain_stress(dem, thickness);
+    let pressure: Vec<f64> = stress.iter().map(|t| -0.5 * (t[0] + t[3])).collect();
     let gname = format!("grains_{k:06}.vtu");
     write_vtu_points(
         &dir.join(&gname),
@@ -150,27 +236,44 @@ fn write_frame(dem: &Dem, s: &Shape, dir: &Path, k: usize, pvd: &mut PvdSeries) 
             Field::vector("velocity", &vel),
             Field::scalar("angular_velocity", &g.omega),
             Field::scalar("contacts", &s.contacts),
+            Field::tensor("stress", &stress),
+            Field::scalar("mean_pressure", &pressure),
         ],
         &[],
         &[],
     )?;
+    let (mut lines, mut f_n, mut f_t, mut wall) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let pl = dem.pairs();
-    let (mut lines, mut f_n, mut f_t) = (Vec::new(), Vec::new(), Vec::new());
     for p in 0..pl.i.len() {
         let st = &pl.state[p];
         if st.touching() {
             lines.push([pl.i[p], pl.j[p]]);
             f_n.push(st.f_n);
             f_t.push(st.f_t);
+            wall.push(0.0);
+        }
+    }
+    let wl = dem.wall_pairs();
+    for p in 0..wl.grain.len() {
+        let st = &wl.state[p];
+        if st.touching() {
+            let i = wl.grain[p] as usize;
+            let (dist, nrm) = dem.walls[wl.wall[p] as usize].distance([g.x[i], g.y[i]]);
+            lines.push([i as u32, points.len() as u32]);
+            points.push([g.x[i] + dist * nrm[0], g.y[i] + dist * nrm[1]]);
+            f_n.push(st.f_n);
+            f_t.push(st.f_t);
+            wall.push(1.0);
         }
     }
     let cname = format!("contacts_{k:06}.vtu");
     // With no touching pair, write the points only (a valid vertex set).
-    let (cf_n, cf_t) = (
+    let fields = [
         Field::scalar("normal_force", &f_n),
         Field::scalar("tangential_force", &f_t),
-    );
-    let cells: &[Field] = if lines.is_empty() { &[] } else { &[cf_n, cf_t] };
+        Field::scalar("wall", &wall),
+    ];
+    let cells: &[Field] = if lines.is_empty() { &[] } else { &fields };
     write_vtu_points(&dir.join(&cname), &points, &[], &lines, cells)?;
     pvd.add(dem.time(), 0, &gname)?;
     pvd.add(dem.time(), 1, &cname)
@@ -197,6 +300,7 @@ pub fn run_column_collapse(
         Wall::right(scenario.column.box_length),
     ];
     let mut dem = Dem::new(column.grains, walls, d.params.clone())?;
+    dem.refresh_forces();
     let e0 = dem.energy();
     let ts = &scenario.time;
     let dt = dem.dt();
@@ -224,6 +328,7 @@ pub fn run_column_collapse(
     let rest_limit = ts.rest_kinetic_fraction * e0.potential;
     let (mut rest_since, mut at_rest) = (None::<f64>, false);
     let (mut row, mut frame) = (0u64, 0usize);
+    let mut history = Vec::new();
     let t_run = Instant::now();
     let budget = |e: &super::Energy| (e.total() - e0.total()).abs() / e.dissipated().max(1e-300);
     let mut last;
@@ -231,6 +336,7 @@ pub fn run_column_collapse(
         let e = dem.energy();
         let s = shape(&dem);
         let t = dem.time();
+        history.push((t, s.runout));
         csv.row(&[
             t,
             t / tau_c,
@@ -247,7 +353,14 @@ pub fn run_column_collapse(
             budget(&e),
         ])?;
         if row % frame_every == 0 {
-            write_frame(&dem, &s, out_dir, frame, &mut pvd)?;
+            write_frame(
+                &dem,
+                &s,
+                scenario.grains.thickness,
+                out_dir,
+                frame,
+                &mut pvd,
+            )?;
             frame += 1;
         }
         row += 1;
@@ -269,7 +382,14 @@ pub fn run_column_collapse(
     }
     let wall_time_s = t_run.elapsed().as_secs_f64();
     if (row - 1) % frame_every != 0 {
-        write_frame(&dem, &last.0, out_dir, frame, &mut pvd)?;
+        write_frame(
+            &dem,
+            &last.0,
+            scenario.grains.thickness,
+            out_dir,
+            frame,
+            &mut pvd,
+        )?;
     }
     let (s, e) = last;
     let steps = dem.step_count();
@@ -285,7 +405,8 @@ pub fn run_column_collapse(
         h_f: s.height,
         delta_l: (s.runout - l_i) / l_i,
         h_f_over_l_i: s.height / l_i,
-        stop_time_tc: rest_since.unwrap_or(dem.time()) / tau_c,
+        stop_time_tc: spreading_end(&history, STOP_TOLERANCE * l_i) / tau_c,
+        rest_time_tc: rest_since.unwrap_or(dem.time()) / tau_c,
         at_rest,
         dt,
         steps,
@@ -296,4 +417,25 @@ pub fn run_column_collapse(
     };
     write_json(&out_dir.join("summary.json"), &summary)?;
     Ok(summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::spreading_end;
+
+    #[test]
+    fn spreading_ends_when_the_runout_settles() {
+        let h = [
+            (0.0, 1.0),
+            (1.0, 2.0),
+            (2.0, 2.9),
+            (3.0, 3.02),
+            (4.0, 2.99),
+            (5.0, 3.0),
+        ];
+        assert_eq!(spreading_end(&h, 0.05), 3.0);
+        assert_eq!(spreading_end(&h, 0.001), 5.0);
+        assert_eq!(spreading_end(&h, 10.0), 0.0);
+        assert_eq!(spreading_end(&[], 0.1), 0.0);
+    }
 }

@@ -29,9 +29,11 @@
 use rayon::prelude::*;
 
 use super::contact::{self, ContactOut, ContactParams, Law, Motion};
+use super::detect_rapier::RapierDetector;
 use super::energy::Energy;
 use super::grains::Grains;
-use super::neighbours::{Detector, PairList, WallList};
+use super::neighbours::{Detector, PairList, WallList, PAIR_ACTIVE, PAIR_TOUCHING};
+use super::shape_contacts::{ShapeContacts, ShapeSums};
 use super::walls::Wall;
 use crate::{Error, Result};
 
@@ -102,6 +104,18 @@ pub fn critical_step(p: &DemParams, m_min: f64, j_min: f64) -> f64 {
     dt
 }
 
+/// Smallest effective mass of a polygon grain at a contact point (∞ if none):
+/// m_c = 1/(1/m + R_b²/J), R_b the bounding radius — a point on a rotating body is lighter than
+/// its mass (a disk's contact point has m/3 tangentially, which [`critical_step`] already
+/// builds in through 3k_t). Passed as m_min for polygons, it makes the normal and tangential
+/// critical steps conservative.
+fn polygon_contact_mass(g: &Grains) -> f64 {
+    (0..g.len())
+        .filter(|&i| !g.is_disk(i))
+        .map(|i| 1.0 / (1.0 / g.mass[i] + g.radius[i] * g.radius[i] / g.inertia[i]))
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// External loads held during [`Dem::advance_with`] (e.g. hydrodynamic force and torque from
 /// the fluid, seed eq. 5.53–5.54). Empty vectors mean none.
 #[derive(Clone, Debug, Default)]
@@ -149,6 +163,17 @@ impl Part {
         self
     }
 
+    fn add_shapes(mut self, o: &ShapeSums) -> Self {
+        self.e_n += o.e_n;
+        self.e_t += o.e_t;
+        self.e_r += o.e_r;
+        self.d_n += o.d_n;
+        self.d_f += o.d_f;
+        self.d_r += o.d_r;
+        self.contacts += o.contacts as f64;
+        self
+    }
+
     fn merge(mut self, o: &Part) -> Self {
         self.e_n += o.e_n;
         self.e_t += o.e_t;
@@ -180,6 +205,13 @@ pub struct Dem {
     wall_pairs: WallList,
     parts: Vec<Part>,
     gparts: Vec<[f64; 2]>,
+    /// 1/m and 1/J per grain, refreshed whenever the forces are re-evaluated from scratch
+    /// ([`Dem::invalidate_forces`]).
+    inv_mass: Vec<f64>,
+    inv_inertia: Vec<f64>,
+    /// Whether some grain moved more than skin/2 since the last list build (found in the
+    /// drift, so the check costs no extra pass).
+    moved: bool,
     /// End-of-step velocity estimates v* (x, y, ω) for the dashpots.
     vxp: Vec<f64>,
     vyp: Vec<f64>,
@@ -194,6 +226,9 @@ pub struct Dem {
     /// filled in by [`Dem::energy`].
     budget: Energy,
     contacts: usize,
+    /// Pairs the cell list does not handle (polygon grains, polygon walls), through rapier;
+    /// `None` for an all-disk system with straight walls.
+    shapes: Option<ShapeContacts>,
 }
 
 impl Dem {
@@ -244,7 +279,11 @@ impl Dem {
                 ));
             }
         }
-        let dt_cr = critical_step(&params, grains.min_mass(), grains.min_inertia());
+        let dt_cr = critical_step(
+            &params,
+            grains.min_mass().min(polygon_contact_mass(&grains)),
+            grains.min_inertia(),
+        );
         let dt_max = params.lambda * dt_cr;
         let dt = match params.dt {
             Some(dt) if !(dt > 0.0 && dt.is_finite()) => {
@@ -270,7 +309,9 @@ impl Dem {
             }
         };
         let skin = params.skin_fraction * 2.0 * grains.max_radius().max(f64::MIN_POSITIVE);
+        let shapes = RapierDetector::needed(&grains, &walls).then(|| ShapeContacts::new(skin));
         Ok(Dem {
+            shapes,
             grain_law: Law::from(&params.grain),
             wall_law: Law::from(&params.wall),
             grains,
@@ -285,6 +326,9 @@ impl Dem {
             wall_pairs: WallList::default(),
             parts: Vec::new(),
             gparts: Vec::new(),
+            inv_mass: Vec::new(),
+            inv_inertia: Vec::new(),
+            moved: true,
             vxp: Vec::new(),
             vyp: Vec::new(),
             wp: Vec::new(),
@@ -342,6 +386,12 @@ impl Dem {
         &self.pairs
     }
 
+    /// Contacts found by the rapier detector (polygon grains, polygon walls); `None` when the
+    /// system needs none.
+    pub fn shape_contacts(&self) -> Option<&ShapeContacts> {
+        self.shapes.as_ref()
+    }
+
     /// Grain–wall pairs in the neighbour list.
     pub fn wall_pairs(&self) -> &WallList {
         &self.wall_pairs
@@ -367,13 +417,21 @@ impl Dem {
         if !self.forces_valid {
             // Springs not evaluated yet: history is zero except normal overlap.
             let mut c = self.clone();
-            c.compute_forces(0.0, None);
+            c.evaluate_from_scratch(None);
             e = c.budget;
         }
         e.kinetic = k;
         e.rotational = r;
         e.potential = p;
         e
+    }
+
+    /// Evaluate the forces at the current state without advancing anything (e.g. before
+    /// reading contact forces of a system built by hand); a no-op if they are current.
+    pub fn refresh_forces(&mut self) {
+        if !self.forces_valid {
+            self.evaluate_from_scratch(None);
+        }
     }
 
     /// Mark the forces stale after editing [`Dem::grains`] by hand (positions, velocities);
@@ -432,16 +490,29 @@ impl Dem {
     /// One velocity-Verlet step of size `dt` (see the module documentation).
     pub fn step_dt(&mut self, dt: f64, loads: Option<&ExternalLoads>) {
         if !self.forces_valid {
-            self.compute_forces(0.0, loads);
+            self.evaluate_from_scratch(loads);
         }
         self.kick_drift(dt);
-        self.compute_forces(dt, loads);
-        self.kick(dt);
+        self.compute_forces(dt, loads, 0.5 * dt);
         self.apply_events();
         self.time += dt;
         self.steps += 1;
     }
 
+    /// Forces at the current state without advancing the springs, after the grains were
+    /// edited by hand (or at the start): masses and positions are read afresh.
+    fn evaluate_from_scratch(&mut self, loads: Option<&ExternalLoads>) {
+        let g = &self.grains;
+        self.inv_mass.clear();
+        self.inv_mass.extend(g.mass.iter().map(|m| 1.0 / m));
+        self.inv_inertia.clear();
+        self.inv_inertia.extend(g.inertia.iter().map(|j| 1.0 / j));
+        self.moved = self.detector.needs_rebuild(g);
+        self.compute_forces(0.0, loads, 0.0);
+    }
+
+    /// Steps 1–2: first half-kick and drift; also finds whether some grain moved more than
+    /// skin/2 since the last list build (step 3), in the same pass.
     fn kick_drift(&mut self, dt: f64) {
         let h = 0.5 * dt;
         let g = &mut self.grains;
@@ -449,8 +520,15 @@ impl Dem {
         self.vxp.resize(n, 0.0);
         self.vyp.resize(n, 0.0);
         self.wp.resize(n, 0.0);
-        let (m, jn) = (&g.mass, &g.inertia);
-        g.x.par_chunks_mut(GRAIN_CHUNK)
+        let (im, ij) = (&self.inv_mass, &self.inv_inertia);
+        let (fx, fy, tq) = (&g.fx, &g.fy, &g.torque);
+        let (xr, yr, lim) = self.detector.reference();
+        if xr.len() != n {
+            self.moved = true;
+        }
+        let moved = g
+            .x
+            .par_chunks_mut(GRAIN_CHUNK)
             .zip(g.y.par_chunks_mut(GRAIN_CHUNK))
             .zip(g.vx.par_chunks_mut(GRAIN_CHUNK))
             .zip(g.vy.par_chunks_mut(GRAIN_CHUNK))
@@ -460,12 +538,12 @@ impl Dem {
             .zip(self.vyp.par_chunks_mut(GRAIN_CHUNK))
             .zip(self.wp.par_chunks_mut(GRAIN_CHUNK))
             .enumerate()
-            .for_each(|(c, ((((((((x, y), vx), vy), th), w), vxp), vyp), wp))| {
-                let o = c * GRAIN_CHUNK;
-                for k in 0..x.len() {
-                    let i = o + k;
-                    let inv = h / m[i];
-                    let (ax, ay, al) = (inv * g.fx[i], inv * g.fy[i], h / jn[i] * g.torque[i]);
+            .map(|(c, ((((((((x, y), vx), vy), th), w), vxp), vyp), wp))| {
+                let (o, len) = (c * GRAIN_CHUNK, x.len());
+                let (im, ij) = (&im[o..o + len], &ij[o..o + len]);
+                let (fx, fy, tq) = (&fx[o..o + len], &fy[o..o + len], &tq[o..o + len]);
+                for k in 0..len {
+                    let (ax, ay, al) = (h * im[k] * fx[k], h * im[k] * fy[k], h * ij[k] * tq[k]);
                     vx[k] += ax;
                     vy[k] += ay;
                     w[k] += al;
@@ -476,26 +554,21 @@ impl Dem {
                     vyp[k] = vy[k] + ay;
                     wp[k] = w[k] + al;
                 }
-            });
-    }
-
-    fn kick(&mut self, dt: f64) {
-        let h = 0.5 * dt;
-        let g = &mut self.grains;
-        let (m, jn, fx, fy, tq) = (&g.mass, &g.inertia, &g.fx, &g.fy, &g.torque);
-        g.vx.par_chunks_mut(GRAIN_CHUNK)
-            .zip(g.vy.par_chunks_mut(GRAIN_CHUNK))
-            .zip(g.omega.par_chunks_mut(GRAIN_CHUNK))
-            .enumerate()
-            .for_each(|(c, ((vx, vy), w))| {
-                let o = c * GRAIN_CHUNK;
-                for k in 0..vx.len() {
-                    let i = o + k;
-                    vx[k] += h / m[i] * fx[i];
-                    vy[k] += h / m[i] * fy[i];
-                    w[k] += h / jn[i] * tq[i];
+                if xr.len() != n {
+                    return true;
                 }
-            });
+                let (xr, yr) = (&xr[o..o + len], &yr[o..o + len]);
+                let mut far = false;
+                for k in 0..len {
+                    let (dx, dy) = (x[k] - xr[k], y[k] - yr[k]);
+                    let r2 = dx * dx + dy * dy;
+                    // A non-finite grain forces a rebuild too.
+                    far |= r2 > lim || r2.is_nan();
+                }
+                far
+            })
+            .reduce(|| false, |a, b| a || b);
+        self.moved |= moved;
     }
 
     /// Turn the force arrays from **F**^end (just used by the second half-kick) into the true
@@ -518,12 +591,18 @@ impl Dem {
                 g.torque[j] += d[3];
             }
         }
+        if let Some(sc) = &self.shapes {
+            sc.apply_events(g);
+        }
     }
 
-    /// Evaluate all forces at the current positions and velocities; springs advance by
-    /// `dt_hist` (0: evaluate without advancing), dissipation accrues over `dt_hist`.
-    fn compute_forces(&mut self, dt_hist: f64, loads: Option<&ExternalLoads>) {
-        if self.detector.needs_rebuild(&self.grains) {
+    /// Steps 3–5: rebuild the lists if needed, evaluate all forces at the current positions
+    /// and velocities (springs advance by `dt_hist`, 0: evaluate without advancing;
+    /// dissipation accrues over `dt_hist`) and, in the same pass over the grains, apply the
+    /// second half-kick **v** += `kick`·**F**^end/m (`kick` = ½Δt; 0: no kick).
+    fn compute_forces(&mut self, dt_hist: f64, loads: Option<&ExternalLoads>, kick: f64) {
+        if self.moved {
+            self.moved = false;
             self.detector.build(
                 &self.grains,
                 &self.walls,
@@ -549,9 +628,10 @@ impl Dem {
             .state
             .par_chunks_mut(PAIR_CHUNK)
             .zip(self.pairs.out.par_chunks_mut(PAIR_CHUNK))
+            .zip(self.pairs.flags.par_chunks_mut(PAIR_CHUNK))
             .zip(self.events[..nch].par_iter_mut())
             .enumerate()
-            .map(|(c, ((state, out), ev))| {
+            .map(|(c, (((state, out), flags), ev))| {
                 ev.clear();
                 let o = c * PAIR_CHUNK;
                 let mut part = Part::default();
@@ -561,9 +641,9 @@ impl Dem {
                     let (ri, rj) = (g.radius[i], g.radius[j]);
                     let d2 = dx * dx + dy * dy;
                     let rs = ri + rj;
-                    if d2 >= rs * rs && !state[k].touching() {
+                    if d2 >= rs * rs && flags[k] & PAIR_TOUCHING == 0 {
                         // Apart now and at the previous evaluation.
-                        out[k] = [0.0; 4];
+                        flags[k] = 0;
                         continue;
                     }
                     let d = d2.sqrt();
@@ -591,6 +671,7 @@ impl Dem {
                         r_eff: ri * rj / rs,
                     };
                     let r = law.resolve(&motion, &mut state[k], dt_hist);
+                    flags[k] = PAIR_ACTIVE | if r.touching { PAIR_TOUCHING } else { 0 };
                     let [an, at, ar] = r.apply;
                     out[k] = [
                         -an * nx + at * tx,
@@ -676,13 +757,21 @@ impl Dem {
             })
             .collect_into_vec(&mut self.parts);
         total = self.parts.iter().fold(total, |a, b| a.merge(b));
-        // Gather per grain: gravity, global damping, external loads, contacts.
+        // Contacts through rapier (polygon grains or walls), summed per grain for the gather.
+        if let Some(sc) = self.shapes.as_mut() {
+            let vp = (&self.vxp[..], &self.vyp[..], &self.wp[..]);
+            let (gl, wl) = (&self.grain_law, &self.wall_law);
+            let s = sc.evaluate(&self.grains, &self.walls, vp, gl, wl, dt_hist);
+            total = total.add_shapes(&s);
+        }
+        let sf: &[[f64; 3]] = self.shapes.as_ref().map_or(&[], |s| s.grain_force());
+        // Gather per grain: gravity, global damping, external loads, contacts; then kick.
         let grav = self.params.gravity;
         let alpha = self.params.global_damping;
         let (pl, wl) = (&self.pairs, &self.wall_pairs);
         let g = &mut self.grains;
         let (m, x_vx, x_vy) = (&g.mass, &self.vxp, &self.vyp);
-        let (h_vx, h_vy, h_w) = (&g.vx, &g.vy, &g.omega);
+        let (im, ij) = (&self.inv_mass, &self.inv_inertia);
         let empty: &[f64] = &[];
         let (lx, ly, lt) = match loads {
             Some(l) => (&l.fx[..], &l.fy[..], &l.torque[..]),
@@ -691,8 +780,11 @@ impl Dem {
         g.fx.par_chunks_mut(GRAIN_CHUNK)
             .zip(g.fy.par_chunks_mut(GRAIN_CHUNK))
             .zip(g.torque.par_chunks_mut(GRAIN_CHUNK))
+            .zip(g.vx.par_chunks_mut(GRAIN_CHUNK))
+            .zip(g.vy.par_chunks_mut(GRAIN_CHUNK))
+            .zip(g.omega.par_chunks_mut(GRAIN_CHUNK))
             .enumerate()
-            .map(|(c, ((fx, fy), tq))| {
+            .map(|(c, (((((fx, fy), tq), h_vx), h_vy), h_w))| {
                 let o = c * GRAIN_CHUNK;
                 let (mut d_glob, mut w_ext) = (0.0, 0.0);
                 for k in 0..fx.len() {
@@ -700,7 +792,7 @@ impl Dem {
                     // Predictor velocity for the damping force; its work and that of
                     // the (held) external loads over the step use Δx = Δt v_½.
                     let (vx, vy) = (x_vx[i], x_vy[i]);
-                    let (ux, uy, w) = (h_vx[i], h_vy[i], h_w[i]);
+                    let (ux, uy, w) = (h_vx[k], h_vy[k], h_w[k]);
                     let mut f = [
                         m[i] * grav[0] - alpha * m[i] * vx,
                         m[i] * grav[1] - alpha * m[i] * vy,
@@ -721,16 +813,20 @@ impl Dem {
                     }
                     if i + 1 < pl.first.len() {
                         for p in pl.first[i] as usize..pl.first[i + 1] as usize {
-                            let q = &pl.out[p];
-                            f[0] += q[0];
-                            f[1] += q[1];
-                            t += q[2];
+                            if pl.flags[p] & PAIR_ACTIVE != 0 {
+                                let q = &pl.out[p];
+                                f[0] += q[0];
+                                f[1] += q[1];
+                                t += q[2];
+                            }
                         }
                         for &p in &pl.as_j[pl.j_start[i] as usize..pl.j_start[i + 1] as usize] {
-                            let q = &pl.out[p as usize];
-                            f[0] -= q[0];
-                            f[1] -= q[1];
-                            t += q[3];
+                            if pl.flags[p as usize] & PAIR_ACTIVE != 0 {
+                                let q = &pl.out[p as usize];
+                                f[0] -= q[0];
+                                f[1] -= q[1];
+                                t += q[3];
+                            }
                         }
                     }
                     if i + 1 < wl.first.len() {
@@ -741,9 +837,17 @@ impl Dem {
                             t += q[2];
                         }
                     }
+                    if let Some(q) = sf.get(i) {
+                        f[0] += q[0];
+                        f[1] += q[1];
+                        t += q[2];
+                    }
                     fx[k] = f[0];
                     fy[k] = f[1];
                     tq[k] = t;
+                    h_vx[k] += kick * im[i] * f[0];
+                    h_vy[k] += kick * im[i] * f[1];
+                    h_w[k] += kick * ij[i] * t;
                 }
                 [d_glob, w_ext]
             })

@@ -1,4 +1,8 @@
-//! Fixed walls: half-planes (box sides, floor) and straight line segments.
+//! Fixed walls: half-planes (box sides, floor), straight line segments and convex polygons.
+//!
+//! Planes and segments meet disks through the cell list ([`super::neighbours`]) with the
+//! distance below; polygon walls, and every wall a polygon grain meets, go through the rapier2d
+//! detector ([`super::detect_rapier`]).
 //!
 //! A wall reports, for a disk of centre **c**, the distance s from the centre to the wall and
 //! the unit contact normal **n** pointing from the centre towards the wall; the overlap is
@@ -24,7 +28,19 @@ pub enum Wall {
         /// Second end.
         b: [f64; 2],
     },
+    /// A solid convex polygon (an obstacle), `vertices[..n]` in world coordinates, counter-
+    /// clockwise. Contacts with it are found by the rapier2d detector only; [`Wall::distance`]
+    /// reports it out of reach so the cell list never pairs it.
+    Polygon {
+        /// Vertices; only the first `n` are used.
+        vertices: [[f64; 2]; MAX_WALL_VERTICES],
+        /// Number of vertices (3 ≤ n ≤ [`MAX_WALL_VERTICES`]).
+        n: u8,
+    },
 }
+
+/// Most vertices of a polygon wall (the wall stays `Copy`, with no heap object).
+pub const MAX_WALL_VERTICES: usize = 8;
 
 impl Wall {
     /// Floor y = `y0` (grains above).
@@ -51,7 +67,37 @@ impl Wall {
         }
     }
 
-    /// Distance s from `c` to the wall and the unit normal **n** from `c` towards it.
+    /// A convex polygon wall from its vertices (either orientation, stored counter-clockwise);
+    /// `field` names it in the error.
+    pub fn polygon(v: &[[f64; 2]], field: &str) -> crate::Result<Self> {
+        super::shape::check_convex(v, field)?;
+        if v.len() > MAX_WALL_VERTICES {
+            return Err(crate::Error::config(
+                field,
+                format!(
+                    "a polygon wall has at most {MAX_WALL_VERTICES} vertices, got {}",
+                    v.len()
+                ),
+            ));
+        }
+        let mut vertices = [[0.0; 2]; MAX_WALL_VERTICES];
+        vertices[..v.len()].copy_from_slice(v);
+        if super::shape::polygon_props(v).area < 0.0 {
+            vertices[..v.len()].reverse();
+        }
+        Ok(Wall::Polygon {
+            vertices,
+            n: v.len() as u8,
+        })
+    }
+
+    /// Whether the cell list handles this wall for disks (planes and segments).
+    pub fn is_straight(&self) -> bool {
+        !matches!(self, Wall::Polygon { .. })
+    }
+
+    /// Distance s from `c` to the wall and the unit normal **n** from `c` towards it
+    /// (s = ∞ for a polygon wall, which only the rapier detector sees).
     #[inline(always)]
     pub fn distance(&self, c: [f64; 2]) -> (f64, [f64; 2]) {
         match *self {
@@ -77,6 +123,7 @@ impl Wall {
                     (0.0, [ey / l, -ex / l])
                 }
             }
+            Wall::Polygon { .. } => (f64::INFINITY, [0.0, 0.0]),
         }
     }
 
@@ -99,6 +146,15 @@ impl Wall {
                         "segment needs two distinct finite end points",
                     ));
                 }
+            }
+            Wall::Polygon { vertices, n } => {
+                if !(3..=MAX_WALL_VERTICES).contains(&(n as usize)) {
+                    return Err(crate::Error::config(
+                        field,
+                        format!("polygon wall needs 3 to {MAX_WALL_VERTICES} vertices, got {n}"),
+                    ));
+                }
+                super::shape::check_convex(&vertices[..n as usize], field)?;
             }
         }
         Ok(())

@@ -47,6 +47,9 @@ pub enum FieldData<'a> {
     Scalar(&'a [f64]),
     /// One 2-D vector per cell (or point); written with three components, `z = 0`.
     Vector(&'a [[f64; 2]]),
+    /// One 2 × 2 tensor per cell (or point), row-major `[xx, xy, yx, yy]`; written as a 3 × 3
+    /// tensor (nine components) with the z row and column zero.
+    Tensor(&'a [[f64; 4]]),
 }
 
 impl FieldData<'_> {
@@ -55,6 +58,7 @@ impl FieldData<'_> {
         match self {
             FieldData::Scalar(v) => v.len(),
             FieldData::Vector(v) => v.len(),
+            FieldData::Tensor(v) => v.len(),
         }
     }
 
@@ -87,6 +91,14 @@ impl<'a> Field<'a> {
         Field {
             name,
             data: FieldData::Vector(values),
+        }
+    }
+
+    /// A 2 × 2 tensor field, row-major `[xx, xy, yx, yy]`.
+    pub fn tensor(name: &'a str, values: &'a [[f64; 4]]) -> Self {
+        Field {
+            name,
+            data: FieldData::Tensor(values),
         }
     }
 }
@@ -134,6 +146,15 @@ fn attributes(path: &Path, what: &str, fields: &[Field], n: usize) -> Result<Vec
                     data: v
                         .iter()
                         .flat_map(|&[x, y]| [x, y, 0.0])
+                        .collect::<Vec<f64>>()
+                        .into(),
+                },
+                FieldData::Tensor(v) => DataArray {
+                    name: f.name.to_owned(),
+                    elem: ElementType::Tensors,
+                    data: v
+                        .iter()
+                        .flat_map(|&[xx, xy, yx, yy]| [xx, xy, 0.0, yx, yy, 0.0, 0.0, 0.0, 0.0])
                         .collect::<Vec<f64>>()
                         .into(),
                 },

@@ -307,6 +307,11 @@ pub const CASES: &[Case] = &[
         run: |f| checks_only(crate::dem::validation::energy_budget(f)),
     },
     Case {
+        name: "dem-polygon",
+        description: "rapier2d detector = cell list on disks; polygon grains: rest, rough incline, momentum, budget",
+        run: |f| checks_only(crate::dem::validation_polygon::polygons(f)),
+    },
+    Case {
         name: "mpm-selfweight",
         description: "elastic column under gravity: σ_yy = −ρg(H − y) within 2 % of ρgH",
         run: |f| checks_only(crate::mpm::validation::selfweight(f)),
@@ -318,12 +323,12 @@ pub const CASES: &[Case] = &[
     },
     Case {
         name: "mpm-cell-crossing",
-        description: "block translating across cells: GIMP stress noise ≥ 10× below standard MPM",
+        description: "points crossing cells (compacting column): GIMP stress error ≥ 10× below standard MPM",
         run: |f| checks_only(crate::mpm::validation::cell_crossing(f)),
     },
     Case {
         name: "mpm-conservation",
-        description: "MPM mass exact, momentum to round-off (USF, USL, MUSL)",
+        description: "MPM mass exact, momentum to round-off (USF, USL, MUSL, MUSL + PIC)",
         run: |f| checks_only(crate::mpm::validation::conservation(f)),
     },
     Case {

@@ -1,0 +1,340 @@
+//! General contact detection through rapier2d's collision pipeline (`rapier2d-f64`, so the
+//! contact geometry is computed in f64): broad phase (BVH) and narrow phase (contact
+//! manifolds) for every shape — disks, convex polygon grains, half-planes, segments and convex
+//! polygon walls.
+//!
+//! Each grain is a collider without a rigid body (rapier integrates nothing; we move the
+//! colliders to the grains' poses each step); each wall a fixed collider. A contact manifold
+//! point gives, in the convention of the cell list ([`super::neighbours`] + the force loop of
+//! [`super::solver`]):
+//!
+//! * the pair (i, j), i < j for two grains, (grain, wall) otherwise;
+//! * the overlap δ = −dist (rapier's signed distance between the two contact points, < 0 when
+//!   the shapes penetrate);
+//! * the unit normal **n** from i towards j (or the wall): rapier's manifold normal
+//!   **n**₁ = R₁ **n**₁^local, outward from the first collider, negated when the pair is
+//!   stored the other way round;
+//! * the contact point **p** = ½(**p**₁ + **p**₂), the midpoint of the two surface points, which
+//!   is the lever arm origin for the torque: **r**_i = **p** − **x**_i (for a disk
+//!   **r**_i = (R_i − δ/2)**n**);
+//! * a key made of the two feature ids (vertex/face), which follows a contact point from one
+//!   step to the next for the contact history.
+//!
+//! Points closer than the prediction distance (the Verlet skin) are reported too (δ < 0), so
+//! the contact law sees a contact open and close.
+//!
+//! Which pairs it sees is set by [`Coverage`]: `All` (every grain pair and grain–wall pair; used
+//! by the cross-check against the cell list) or `Complement` (only the pairs the cell list does
+//! not handle: any pair with a polygon grain, and disk–polygon-wall pairs). The solver uses
+//! `Complement`, and only when the system has a polygon grain or a polygon wall, so an all-disk
+//! system never pays for rapier. Disks are still inserted in `Complement` mode (a disk may touch
+//! a polygon) but collision groups keep disk–disk and disk–straight-wall pairs out of the
+//! narrow phase.
+
+use rapier2d_f64::geometry::{
+    ActiveCollisionTypes, BroadPhaseBvh, ColliderBuilder, ColliderHandle, ColliderSet, Group,
+    InteractionGroups, InteractionTestMode, NarrowPhase, SharedShape,
+};
+use rapier2d_f64::math::{Pose, Vector};
+use rapier2d_f64::pipeline::CollisionPipeline;
+use rapier2d_f64::prelude::{IslandManager, RigidBodySet};
+
+use super::grains::Grains;
+use super::neighbours::{Detector, PairList, WallList};
+use super::walls::Wall;
+
+/// Which pairs the rapier detector reports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Coverage {
+    /// Every grain–grain and grain–wall pair.
+    All,
+    /// Only pairs the cell list does not handle: a polygon grain on either side, or a disk and
+    /// a polygon wall.
+    Complement,
+}
+
+/// `Contact::j` of a wall contact has this bit set; the wall index is in the low bits.
+pub const WALL_BIT: u32 = 1 << 31;
+
+/// One contact point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    /// First grain.
+    pub i: u32,
+    /// Second grain (> i), or `WALL_BIT | wall index`.
+    pub j: u32,
+    /// Overlap δ (> 0: the shapes overlap).
+    pub delta: f64,
+    /// Unit normal from i towards j (or the wall).
+    pub normal: [f64; 2],
+    /// Contact point (midpoint of the two surface points).
+    pub point: [f64; 2],
+    /// Feature ids of the two sides (i's in the high half), stable while the same vertex/face
+    /// pair is in contact.
+    pub key: u64,
+}
+
+impl Contact {
+    /// Sort key (i, j, features).
+    #[inline]
+    pub fn order(&self) -> (u32, u32, u64) {
+        (self.i, self.j, self.key)
+    }
+
+    /// The wall index if this is a grain–wall contact.
+    #[inline]
+    pub fn wall(&self) -> Option<usize> {
+        (self.j & WALL_BIT != 0).then_some((self.j & !WALL_BIT) as usize)
+    }
+}
+
+const G_DISK: Group = Group::GROUP_1;
+const G_POLY: Group = Group::GROUP_2;
+const G_STRAIGHT: Group = Group::GROUP_3;
+const G_POLY_WALL: Group = Group::GROUP_4;
+
+/// The rapier2d collision pipeline with one collider per grain and per wall.
+pub struct RapierDetector {
+    coverage: Coverage,
+    /// Prediction distance: points up to this gap are reported (δ ≥ −prediction).
+    pub prediction: f64,
+    bodies: RigidBodySet,
+    colliders: ColliderSet,
+    islands: IslandManager,
+    broad: BroadPhaseBvh,
+    narrow: NarrowPhase,
+    pipeline: CollisionPipeline,
+    grain_handles: Vec<ColliderHandle>,
+    /// Shapes the colliders were built for (rebuilt if the grains or walls change).
+    built_for: (usize, usize),
+}
+
+impl std::fmt::Debug for RapierDetector {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RapierDetector")
+            .field("coverage", &self.coverage)
+            .field("prediction", &self.prediction)
+            .field("colliders", &self.colliders.len())
+            .finish()
+    }
+}
+
+impl Clone for RapierDetector {
+    /// A clone starts with no colliders and builds them at its first [`RapierDetector::detect`]
+    /// (rapier's caches are not part of the state: contact history lives with the caller).
+    fn clone(&self) -> Self {
+        RapierDetector::new(self.coverage, self.prediction)
+    }
+}
+
+impl RapierDetector {
+    /// A detector reporting the pairs of `coverage` with points up to `prediction` apart.
+    pub fn new(coverage: Coverage, prediction: f64) -> Self {
+        RapierDetector {
+            coverage,
+            prediction,
+            bodies: RigidBodySet::new(),
+            colliders: ColliderSet::new(),
+            islands: IslandManager::new(),
+            broad: BroadPhaseBvh::new(),
+            narrow: NarrowPhase::new(),
+            pipeline: CollisionPipeline::new(),
+            grain_handles: Vec::new(),
+            built_for: (usize::MAX, usize::MAX),
+        }
+    }
+
+    /// Whether a system needs the rapier detector at all (some polygon grain or polygon wall).
+    pub fn needed(g: &Grains, walls: &[Wall]) -> bool {
+        g.has_polygons() || walls.iter().any(|w| !w.is_straight())
+    }
+
+    fn groups(&self, kind: Group) -> InteractionGroups {
+        let filter = match (self.coverage, kind) {
+            (Coverage::All, k) if k == G_DISK || k == G_POLY => Group::ALL,
+            (Coverage::All, _) => G_DISK | G_POLY,
+            (Coverage::Complement, k) if k == G_DISK => G_POLY | G_POLY_WALL,
+            (Coverage::Complement, k) if k == G_POLY => Group::ALL,
+            (Coverage::Complement, k) if k == G_STRAIGHT => G_POLY,
+            (Coverage::Complement, _) => G_DISK | G_POLY,
+        };
+        InteractionGroups::new(kind, filter, InteractionTestMode::And)
+    }
+
+    fn build(&mut self, g: &Grains, walls: &[Wall]) {
+        self.bodies = RigidBodySet::new();
+        self.colliders = ColliderSet::new();
+        self.islands = IslandManager::new();
+        self.broad = BroadPhaseBvh::new();
+        self.narrow = NarrowPhase::new();
+        self.grain_handles.clear();
+        let mut scratch: Vec<Vector> = Vec::new();
+        for i in 0..g.len() {
+            let (shape, kind) = if g.is_disk(i) {
+                (SharedShape::ball(g.radius[i]), G_DISK)
+            } else {
+                let s = g.shape[i] as usize;
+                scratch.clear();
+                scratch.extend(
+                    g.polygons
+                        .vertices(s)
+                        .iter()
+                        .map(|v| Vector::new(v[0], v[1])),
+                );
+                let shape = SharedShape::convex_polyline(scratch.clone())
+                    .expect("polygon shapes are checked convex when added");
+                (shape, G_POLY)
+            };
+            let c = ColliderBuilder::new(shape)
+                .position(Pose::new(Vector::new(g.x[i], g.y[i]), g.angle[i]))
+                .collision_groups(self.groups(kind))
+                .active_collision_types(ActiveCollisionTypes::all())
+                .user_data(i as u128)
+                .build();
+            self.grain_handles.push(self.colliders.insert(c));
+        }
+        for (w, wall) in walls.iter().enumerate() {
+            let (shape, pose, kind) = match *wall {
+                Wall::Plane { point, normal } => (
+                    SharedShape::halfspace(Vector::new(normal[0], normal[1])),
+                    Pose::new(Vector::new(point[0], point[1]), 0.0),
+                    G_STRAIGHT,
+                ),
+                Wall::Segment { a, b } => (
+                    SharedShape::segment(Vector::new(a[0], a[1]), Vector::new(b[0], b[1])),
+                    Pose::identity(),
+                    G_STRAIGHT,
+                ),
+                Wall::Polygon { vertices, n } => (
+                    SharedShape::convex_polyline(
+                        vertices[..n as usize]
+                            .iter()
+                            .map(|v| Vector::new(v[0], v[1]))
+                            .collect(),
+                    )
+                    .expect("polygon walls are checked convex when made"),
+                    Pose::identity(),
+                    G_POLY_WALL,
+                ),
+            };
+            let c = ColliderBuilder::new(shape)
+                .position(pose)
+                .collision_groups(self.groups(kind))
+                .active_collision_types(ActiveCollisionTypes::all())
+                .user_data(u128::from(WALL_BIT) | w as u128)
+                .build();
+            self.colliders.insert(c);
+        }
+        self.built_for = (g.len(), walls.len());
+    }
+
+    /// Move the grain colliders to the grains' poses, run rapier's broad and narrow phase, and
+    /// write every contact point (δ > −prediction) of the covered pairs into `out`, sorted by
+    /// (i, j, key).
+    pub fn detect(&mut self, g: &Grains, walls: &[Wall], out: &mut Vec<Contact>) {
+        if self.built_for != (g.len(), walls.len()) {
+            self.build(g, walls);
+        } else {
+            for (i, &h) in self.grain_handles.iter().enumerate() {
+                if let Some(c) = self.colliders.get_mut(h) {
+                    c.set_position(Pose::new(Vector::new(g.x[i], g.y[i]), g.angle[i]));
+                }
+            }
+        }
+        self.pipeline.step(
+            self.prediction,
+            &mut self.islands,
+            &mut self.broad,
+            &mut self.narrow,
+            &mut self.bodies,
+            &mut self.colliders,
+            &(),
+            &(),
+        );
+        out.clear();
+        for pair in self.narrow.contact_pairs() {
+            let manifolds = pair.manifolds();
+            if manifolds.is_empty() {
+                continue;
+            }
+            let (c1, c2) = (
+                &self.colliders[pair.collider1],
+                &self.colliders[pair.collider2],
+            );
+            let (u1, u2) = (c1.user_data as u32, c2.user_data as u32);
+            // Store (grain, grain) with i < j, or (grain, wall).
+            let swap = (u1 & WALL_BIT != 0) || (u2 & WALL_BIT == 0 && u1 > u2);
+            let (i, j) = if swap { (u2, u1) } else { (u1, u2) };
+            let (p1, p2) = (c1.position(), c2.position());
+            for m in manifolds {
+                let n = p1.rotation * m.local_n1;
+                let n = if swap { -n } else { n };
+                for pt in &m.points {
+                    let (a, b) = (
+                        p1.transform_point(pt.local_p1),
+                        p2.transform_point(pt.local_p2),
+                    );
+                    let p = 0.5 * (a + b);
+                    let (f1, f2) = (u64::from(pt.fid1.0), u64::from(pt.fid2.0));
+                    out.push(Contact {
+                        i,
+                        j,
+                        delta: -pt.dist,
+                        normal: [n.x, n.y],
+                        point: [p.x, p.y],
+                        key: if swap { f2 << 32 | f1 } else { f1 << 32 | f2 },
+                    });
+                }
+            }
+        }
+        out.sort_unstable_by_key(|c| c.order());
+    }
+}
+
+/// The contacts the cell list finds (disks only: disk–disk and disk–plane/segment pairs), with
+/// δ and **n** computed exactly as the solver's force loop does: **n** = (**x**_j − **x**_i)/d,
+/// δ = R_i + R_j − d; for a wall (s, **n**) = [`Wall::distance`], δ = R_i − s. The point is
+/// **x**_i + (R_i − δ/2)**n**, key 0. Points with δ > −`gap` are listed, sorted by (i, j).
+/// For the cross-check with [`RapierDetector`] (Coverage::All).
+pub fn cell_list_contacts(g: &Grains, walls: &[Wall], skin: f64, gap: f64) -> Vec<Contact> {
+    let mut det = Detector::new(skin);
+    let (mut pl, mut wl) = (PairList::default(), WallList::default());
+    det.build(g, walls, &mut pl, &mut wl);
+    let mut out = Vec::new();
+    for p in 0..pl.i.len() {
+        let (i, j) = (pl.i[p] as usize, pl.j[p] as usize);
+        let (dx, dy) = (g.x[j] - g.x[i], g.y[j] - g.y[i]);
+        let d = (dx * dx + dy * dy).sqrt();
+        let delta = g.radius[i] + g.radius[j] - d;
+        if delta > -gap {
+            let n = [dx / d, dy / d];
+            let l = g.radius[i] - 0.5 * delta;
+            out.push(Contact {
+                i: i as u32,
+                j: j as u32,
+                delta,
+                normal: n,
+                point: [g.x[i] + l * n[0], g.y[i] + l * n[1]],
+                key: 0,
+            });
+        }
+    }
+    for p in 0..wl.grain.len() {
+        let (i, w) = (wl.grain[p] as usize, wl.wall[p] as usize);
+        let (s, n) = walls[w].distance([g.x[i], g.y[i]]);
+        let delta = g.radius[i] - s;
+        if delta > -gap {
+            let l = g.radius[i] - 0.5 * delta;
+            out.push(Contact {
+                i: i as u32,
+                j: WALL_BIT | w as u32,
+                delta,
+                normal: n,
+                point: [g.x[i] + l * n[0], g.y[i] + l * n[1]],
+                key: 0,
+            });
+        }
+    }
+    out.sort_unstable_by_key(|c| c.order());
+    out
+}

@@ -38,6 +38,7 @@ pub mod dem;
 pub mod error;
 pub mod io;
 pub mod lbm;
+pub mod mpm;
 pub mod run;
 pub mod scale;
 pub mod units;

@@ -72,6 +72,27 @@ enum Collision {
 
 #[derive(Subcommand)]
 enum Bench {
+    /// GIMPM step on a collapsing column, in material point-steps per second.
+    Mpm {
+        /// Material points (about; the column is w × 2w cells with 4 points per cell).
+        #[arg(long, default_value_t = 8192)]
+        points: usize,
+        /// Steps per repeat.
+        #[arg(long, default_value_t = 200)]
+        steps: u64,
+        /// Threads (0: all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Timed repeats; the median is reported.
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Shape functions: gimp or standard.
+        #[arg(long, default_value = "gimp")]
+        shape: String,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// D2Q9 LBM in a periodic box, with the memory-bandwidth roofline measured beside it.
     Lbm {
         /// Cells along x.
@@ -176,9 +197,20 @@ fn is_dem(path: &Path) -> bool {
         .is_some_and(|t| t.contains_key("grains"))
 }
 
+/// Is this an MPM scenario (it has a `[material]` table)?
+fn is_mpm(path: &Path) -> bool {
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|t| t.parse::<toml::Table>().ok())
+        .is_some_and(|t| t.contains_key("material"))
+}
+
 fn check(path: &Path) -> Result<ExitCode> {
     if is_dem(path) {
         return check_dem(path);
+    }
+    if is_mpm(path) {
+        return check_mpm(path);
     }
     let s = Scenario::from_file(path)?;
     let d = s.derive()?;
@@ -262,6 +294,64 @@ fn check_dem(path: &Path) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+fn check_mpm(path: &Path) -> Result<ExitCode> {
+    let s = granflow::mpm::scenario::MpmScenario::from_file(path)?;
+    let d = s.derive()?;
+    println!(
+        "scenario        {} — {} (MPM column collapse)",
+        s.name, s.description
+    );
+    println!(
+        "column          L_i = {:.4e} m, H_i = {:.4e} m, τ_c = {:.4e} s",
+        s.column.width, d.height, d.tau_c
+    );
+    println!(
+        "grid            {} × {} cells of {:.4e} m, {} points",
+        d.cells[0], d.cells[1], s.mpm.cell_size, d.points
+    );
+    println!(
+        "wave speed      c = √((K + 4G/3)/ρ) = {:.4} m/s",
+        d.wave_speed
+    );
+    println!(
+        "dt (CFL)        {:.4e} s (Courant {})",
+        d.dt_cfl, s.mpm.courant
+    );
+    if let Some(dt) = s.time.dt {
+        println!("dt              {dt:.4e} s (given)");
+    }
+    println!("ok");
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_mpm(path: &Path, out: &Path) -> Result<ExitCode> {
+    let s = granflow::mpm::scenario::MpmScenario::from_file(path)?;
+    let d = s.derive()?;
+    eprintln!(
+        "{}: MPM column collapse, {} points -> {}",
+        s.name,
+        d.points,
+        out.display()
+    );
+    let end = (1e3 * s.time.end_tc) as u64;
+    let r = with_progress(end, "milli-τ_c", |p| {
+        granflow::mpm::run::run_column_collapse(&s, out, p)
+    })
+    .with_context(|| stopped(path, out))?;
+    println!(
+        "done: a = {:.3}, L_f = {:.4} m, (L_f − L_i)/L_i = {:.3}, H_f/L_i = {:.3}, stop at {:.2} τ_c ({}), {} points, {:.1} s wall",
+        r.aspect_ratio,
+        r.l_f,
+        r.delta_l,
+        r.h_f_over_l_i,
+        r.stop_time_tc,
+        if r.at_rest { "at rest" } else { "end time reached" },
+        r.points,
+        r.wall_time_s
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
 /// Run `f` with a progress callback: an indicatif bar on a terminal, a plain line every 10 %
 /// otherwise (logs, CI).
 fn with_progress<R>(total: u64, unit: &str, f: impl FnOnce(&mut dyn FnMut(u64, u64)) -> R) -> R {
@@ -325,6 +415,9 @@ fn run_dem(path: &Path, out: &Path) -> Result<ExitCode> {
 fn run(path: &Path, out: &Path) -> Result<ExitCode> {
     if is_dem(path) {
         return run_dem(path, out);
+    }
+    if is_mpm(path) {
+        return run_mpm(path, out);
     }
     let s = Scenario::from_file(path)?;
     let d = s.derive()?;
@@ -436,6 +529,30 @@ fn validate_cmd(case: &str, json: bool, full: bool, figures: Option<&Path>) -> R
 
 fn bench(which: Bench) -> Result<ExitCode> {
     match which {
+        Bench::Mpm {
+            points,
+            steps,
+            threads,
+            repeats,
+            shape,
+            json,
+        } => {
+            let shape = match shape.as_str() {
+                "gimp" => granflow::mpm::ShapeKind::Gimp,
+                "standard" => granflow::mpm::ShapeKind::Standard,
+                other => anyhow::bail!("--shape must be gimp or standard, got {other}"),
+            };
+            let r = granflow::mpm::bench::mpm(points, steps, threads, repeats, shape)?;
+            if json {
+                println!("{}", serde_json::to_string(&r)?);
+            } else {
+                println!(
+                    "mpm {} points ({}×{} cells), {} on {} threads: {:.3e} point-steps/s (samples {:?})",
+                    r.points, r.cells[0], r.cells[1], r.shape, r.threads, r.point_steps_per_s, r.samples
+                );
+            }
+            Ok(ExitCode::SUCCESS)
+        }
         Bench::Lbm {
             nx,
             ny,

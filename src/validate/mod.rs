@@ -333,6 +333,31 @@ pub const CASES: &[Case] = &[
         description: "two disks draft, kiss (gap < Δx) and tumble; times reported",
         run: crate::coupling::validation::dkt,
     },
+    Case {
+        name: "mpm-selfweight",
+        description: "elastic column under gravity: σ_yy = −ρg(H − y) within 2 % of ρgH",
+        run: |f| checks_only(crate::mpm::validation::selfweight(f)),
+    },
+    Case {
+        name: "mpm-mc-biaxial",
+        description: "Mohr–Coulomb plane-strain biaxial: peak σ₁ within 1 %, ψ = 0 isochoric",
+        run: |f| checks_only(crate::mpm::validation::mc_biaxial(f)),
+    },
+    Case {
+        name: "mpm-cell-crossing",
+        description: "points crossing cells (compacting column): GIMP stress error ≥ 10× below standard MPM",
+        run: |f| checks_only(crate::mpm::validation::cell_crossing(f)),
+    },
+    Case {
+        name: "mpm-conservation",
+        description: "MPM mass exact, momentum to round-off (USF, USL, MUSL, MUSL + PIC)",
+        run: |f| checks_only(crate::mpm::validation::conservation(f)),
+    },
+    Case {
+        name: "mpm-friction",
+        description: "block sliding on a Coulomb wall: deceleration μg, distance v₀²/(2μg)",
+        run: |f| checks_only(crate::mpm::validation::sliding_block(f)),
+    },
 ];
 
 /// A report of checks without figures.

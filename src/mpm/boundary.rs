@@ -1,0 +1,148 @@
+//! Boundary conditions on grid nodes: straight walls along grid lines, each constraining the
+//! nodes on and behind it (the wall node row and the ghost nodes outside the domain).
+//!
+//! With n the unit normal pointing into the material and v the nodal velocity after the
+//! momentum update, v_n = v·n, v_t = v − v_n n:
+//!
+//! * `Fixed`: v = 0.
+//! * `Roller`: v_n = 0 (bilateral, frictionless).
+//! * `Friction { mu }`: unilateral Coulomb contact, as the thesis applies to the channel base
+//!   and back wall: if v_n < 0 (moving into the wall) the normal velocity is removed,
+//!   Δv_n = −v_n, and the tangential speed is reduced by at most μ Δv_n:
+//!   v_t ← v_t · max(0, 1 − μ Δv_n/|v_t|) (the impulse m Δv_t is bounded by μ m Δv_n);
+//!   separating nodes (v_n ≥ 0) are free.
+//!
+//! Each constraint returns the velocity change it made, split into its normal and tangential
+//! parts, so the solver can book the work of the constraint impulse (see
+//! [`super::solver`]: D = −m Δv·(v^{n+1} + v^n)/2, the midpoint rule that makes the nodal
+//! kinetic energy balance exact; a wall holding a node at rest does no work).
+
+use serde::{Deserialize, Serialize};
+
+/// Kind of a wall.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case", tag = "kind", deny_unknown_fields)]
+pub enum WallKind {
+    /// No motion.
+    Fixed,
+    /// No normal motion, free tangential motion.
+    Roller,
+    /// Unilateral contact with Coulomb friction μ.
+    Friction {
+        /// Coulomb friction coefficient μ between wall and material.
+        mu: f64,
+    },
+}
+
+/// Which side of the domain a wall bounds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// x = position, material at larger x.
+    Left,
+    /// x = position, material at smaller x.
+    Right,
+    /// y = position, material above.
+    Bottom,
+    /// y = position, material below.
+    Top,
+}
+
+/// A wall on a grid line.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Wall {
+    /// Which side.
+    pub side: Side,
+    /// Coordinate of the wall line (m); nodes at or beyond it are constrained.
+    pub position: f64,
+    /// Condition.
+    pub kind: WallKind,
+}
+
+impl Wall {
+    /// Inward unit normal.
+    pub fn normal(&self) -> [f64; 2] {
+        match self.side {
+            Side::Left => [1.0, 0.0],
+            Side::Right => [-1.0, 0.0],
+            Side::Bottom => [0.0, 1.0],
+            Side::Top => [0.0, -1.0],
+        }
+    }
+
+    /// Whether a node at `x` is on or behind the wall (tolerance `eps`).
+    pub fn holds(&self, x: [f64; 2], eps: f64) -> bool {
+        match self.side {
+            Side::Left => x[0] <= self.position + eps,
+            Side::Right => x[0] >= self.position - eps,
+            Side::Bottom => x[1] <= self.position + eps,
+            Side::Top => x[1] >= self.position - eps,
+        }
+    }
+
+    /// Apply the condition to the velocity `v` of a node; returns the velocity change, split
+    /// into (normal, tangential) parts.
+    #[inline]
+    pub fn apply(&self, v: &mut [f64; 2]) -> ([f64; 2], [f64; 2]) {
+        let n = self.normal();
+        let vn = v[0] * n[0] + v[1] * n[1];
+        let vt = [v[0] - vn * n[0], v[1] - vn * n[1]];
+        let dn = [-vn * n[0], -vn * n[1]];
+        match self.kind {
+            WallKind::Fixed => {
+                *v = [0.0; 2];
+                (dn, [-vt[0], -vt[1]])
+            }
+            WallKind::Roller => {
+                *v = vt;
+                (dn, [0.0; 2])
+            }
+            WallKind::Friction { mu } => {
+                if vn >= 0.0 {
+                    return ([0.0; 2], [0.0; 2]);
+                }
+                let speed = (vt[0] * vt[0] + vt[1] * vt[1]).sqrt();
+                let scale = if speed > 0.0 {
+                    (1.0 - mu * (-vn) / speed).max(0.0)
+                } else {
+                    0.0
+                };
+                *v = [vt[0] * scale, vt[1] * scale];
+                (dn, [vt[0] * (scale - 1.0), vt[1] * (scale - 1.0)])
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Coulomb: the tangential impulse equals μ × the normal impulse while sliding, and
+    /// sticking takes all tangential velocity; separation is free; the changes are reported.
+    #[test]
+    fn coulomb_wall_limits_the_tangential_impulse() {
+        let w = Wall {
+            side: Side::Bottom,
+            position: 0.0,
+            kind: WallKind::Friction { mu: 0.5 },
+        };
+        let mut v = [2.0, -1.0];
+        let (dn, dt) = w.apply(&mut v);
+        assert_eq!(v, [1.5, 0.0]);
+        assert_eq!((dn, dt), ([0.0, 1.0], [-0.5, 0.0]));
+        let mut v = [0.2, -1.0];
+        w.apply(&mut v);
+        assert_eq!(v, [0.0, 0.0]);
+        let mut v = [0.2, 1.0];
+        assert_eq!(w.apply(&mut v), ([0.0; 2], [0.0; 2]));
+        assert_eq!(v, [0.2, 1.0]);
+        let r = Wall {
+            side: Side::Left,
+            position: 0.0,
+            kind: WallKind::Roller,
+        };
+        let mut v = [0.3, -0.4];
+        r.apply(&mut v);
+        assert_eq!(v, [0.0, -0.4]);
+    }
+}

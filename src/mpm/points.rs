@@ -1,0 +1,101 @@
+//! Material points as a structure of arrays: one `Vec` per field (small fixed arrays for the
+//! vector and tensor fields, as Taichi's vector fields), no heap object per point.
+
+use super::material::{MaterialState, Stress};
+
+/// The material points.
+#[derive(Clone, Debug, Default)]
+pub struct Points {
+    /// Position (m).
+    pub pos: Vec<[f64; 2]>,
+    /// Initial position (m), for Lagrangian reference solutions.
+    pub pos0: Vec<[f64; 2]>,
+    /// Velocity (m/s).
+    pub vel: Vec<[f64; 2]>,
+    /// Mass (kg per unit thickness: the model is 2-D, volumes are areas × 1 m).
+    pub mass: Vec<f64>,
+    /// Current volume V = det(F) V₀ (m³ per m).
+    pub vol: Vec<f64>,
+    /// Initial volume V₀.
+    pub vol0: Vec<f64>,
+    /// Deformation gradient F (xx, xy, yx, yy), updated F ← (I + Δt L) F.
+    pub def_grad: Vec<[f64; 4]>,
+    /// Cauchy stress (xx, yy, xy, zz), Pa, tension positive.
+    pub stress: Vec<Stress>,
+    /// Plastic history.
+    pub state: Vec<MaterialState>,
+    /// uGIMP half-width l_p of the point's domain (m); constant (not updated).
+    pub half_size: Vec<f64>,
+    /// Stress work done on the point, ∫ σ : D V dt (J per m), plus its initial elastic energy.
+    pub work: Vec<f64>,
+}
+
+impl Points {
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.pos.len()
+    }
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.pos.is_empty()
+    }
+
+    /// Add one point at rest, unstressed, with F = I.
+    pub fn push(&mut self, pos: [f64; 2], vol: f64, density: f64, half_size: f64) {
+        self.pos.push(pos);
+        self.pos0.push(pos);
+        self.vel.push([0.0; 2]);
+        self.mass.push(vol * density);
+        self.vol.push(vol);
+        self.vol0.push(vol);
+        self.def_grad.push([1.0, 0.0, 0.0, 1.0]);
+        self.stress.push([0.0; 4]);
+        self.state.push(MaterialState::default());
+        self.half_size.push(half_size);
+        self.work.push(0.0);
+    }
+
+    /// Fill the rectangle [x0, x1] × [y0, y1] with `n` × `n` points per cell of size `h` (the
+    /// rectangle's sides should be multiples of h/n), each of volume (h/n)² and half-width
+    /// l_p = h/(2n).
+    pub fn fill_rect(&mut self, lo: [f64; 2], hi: [f64; 2], h: f64, n: usize, density: f64) {
+        let d = h / n as f64;
+        let nx = ((hi[0] - lo[0]) / d).round() as usize;
+        let ny = ((hi[1] - lo[1]) / d).round() as usize;
+        for i in 0..nx {
+            for j in 0..ny {
+                let p = [lo[0] + (i as f64 + 0.5) * d, lo[1] + (j as f64 + 0.5) * d];
+                self.push(p, d * d, density, 0.5 * d);
+            }
+        }
+    }
+
+    /// Reorder every field by `perm` (new k ← old perm[k]), with `scratch` buffers reused.
+    pub fn permute(&mut self, perm: &[u32], scratch: &mut PermuteScratch) {
+        fn apply<T: Copy>(v: &mut Vec<T>, perm: &[u32], s: &mut Vec<T>) {
+            s.clear();
+            s.extend(perm.iter().map(|&k| v[k as usize]));
+            std::mem::swap(v, s);
+        }
+        apply(&mut self.pos, perm, &mut scratch.v2);
+        apply(&mut self.pos0, perm, &mut scratch.v2);
+        apply(&mut self.vel, perm, &mut scratch.v2);
+        apply(&mut self.mass, perm, &mut scratch.s);
+        apply(&mut self.vol, perm, &mut scratch.s);
+        apply(&mut self.vol0, perm, &mut scratch.s);
+        apply(&mut self.half_size, perm, &mut scratch.s);
+        apply(&mut self.work, perm, &mut scratch.s);
+        apply(&mut self.def_grad, perm, &mut scratch.v4);
+        apply(&mut self.stress, perm, &mut scratch.v4);
+        apply(&mut self.state, perm, &mut scratch.st);
+    }
+}
+
+/// Reused buffers of [`Points::permute`].
+#[derive(Clone, Debug, Default)]
+pub struct PermuteScratch {
+    s: Vec<f64>,
+    v2: Vec<[f64; 2]>,
+    v4: Vec<[f64; 4]>,
+    st: Vec<MaterialState>,
+}

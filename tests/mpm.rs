@@ -1,0 +1,202 @@
+//! GIMPM: validation cases at test fidelity, the column-collapse scenario files, the CFL
+//! refusal, and a short collapse run through the output contract.
+
+use std::path::Path;
+
+use granflow::mpm::scenario::MpmScenario;
+use granflow::validate::{run, Fidelity};
+
+fn case_passes(name: &str) {
+    let r = run(name, Fidelity::Test).unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert!(!r.checks.is_empty());
+    for c in &r.checks {
+        println!("{}", serde_json::to_string(c).unwrap());
+    }
+    let failed: Vec<_> = r.checks.iter().filter(|c| !c.pass).collect();
+    assert!(failed.is_empty(), "{name}: failed {failed:#?}");
+}
+
+#[test]
+fn mpm_selfweight() {
+    case_passes("mpm-selfweight");
+}
+
+#[test]
+fn mpm_mc_biaxial() {
+    case_passes("mpm-mc-biaxial");
+}
+
+#[test]
+fn mpm_cell_crossing() {
+    case_passes("mpm-cell-crossing");
+}
+
+#[test]
+fn mpm_conservation() {
+    case_passes("mpm-conservation");
+}
+
+fn model(a: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("models/column_collapse/mpm_a{a}.toml"))
+}
+
+/// Every MPM collapse file parses and derives; its column is the DEM file's.
+#[test]
+fn collapse_models_parse_and_match_the_dem_geometry() {
+    for a in ["0.5", "1", "2", "4", "6"] {
+        let s = MpmScenario::from_file(&model(a)).unwrap_or_else(|e| panic!("a={a}: {e}"));
+        let d = s.derive().unwrap_or_else(|e| panic!("a={a}: {e}"));
+        let dem = granflow::dem::scenario::DemScenario::from_file(
+            &Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join(format!("models/column_collapse/dem_a{a}.toml")),
+        )
+        .unwrap();
+        assert_eq!(s.column.width, dem.column.width);
+        assert_eq!(s.column.aspect_ratio, dem.column.aspect_ratio);
+        assert_eq!(s.column.box_length, dem.column.box_length);
+        assert_eq!(
+            d.points,
+            (d.height / s.mpm.cell_size).round() as usize
+                * (s.column.width / s.mpm.cell_size).round() as usize
+                * 16
+        );
+    }
+}
+
+/// Misspelt keys and bad values are refused with the field named; a Δt above C h/c is refused
+/// with the limit in the message.
+#[test]
+fn bad_scenarios_are_refused_naming_the_field() {
+    let text = std::fs::read_to_string(model("2")).unwrap();
+    let e =
+        MpmScenario::from_toml(&text.replace("cohesion = 0.0", "cohesion = 0.0\ncohesio = 1.0"))
+            .unwrap_err()
+            .to_string();
+    assert!(e.contains("cohesio"), "{e}");
+    let s = MpmScenario::from_toml(
+        &text.replace("friction_angle_deg = 22.2", "friction_angle_deg = -1.0"),
+    )
+    .unwrap();
+    let e = s.derive().unwrap_err().to_string();
+    assert!(e.contains("material.friction_angle_deg"), "{e}");
+    let s = MpmScenario::from_toml(&text.replace("cell_size = 0.0019375", "cell_size = 0.002"))
+        .unwrap();
+    assert!(s
+        .derive()
+        .unwrap_err()
+        .to_string()
+        .contains("mpm.cell_size"));
+    // c ≈ 34.53 m/s, h = 1.9375 mm, C = 0.5: limit ≈ 2.8e-5 s.
+    let s = MpmScenario::from_toml(&text.replace("[time]\n", "[time]\ndt = 1.0e-4\n")).unwrap();
+    let e = s.derive().unwrap_err().to_string();
+    assert!(
+        e.contains("time.dt") && e.contains("CFL limit") && e.contains("2.80"),
+        "{e}"
+    );
+    let e = s.build().unwrap_err().to_string();
+    assert!(e.contains("time.dt"), "{e}");
+    let s = MpmScenario::from_toml(&text.replace("[time]\n", "[time]\ndt = 1.0e-6\n")).unwrap();
+    assert_eq!(s.build().unwrap().0.dt(), 1e-6);
+}
+
+/// A short stretch of the a = 2 collapse writes the DEM's summary keys, the time series and a
+/// ParaView series; the mass starts to spread and energy is only lost, not gained.
+#[test]
+fn short_collapse_writes_the_output_contract() {
+    let text = std::fs::read_to_string(model("2")).unwrap();
+    let s = MpmScenario::from_toml(&text.replace("end_tc = 15.0", "end_tc = 0.5")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let r = granflow::mpm::run::run_column_collapse(&s, dir.path(), &mut |_, _| {}).unwrap();
+    assert!(!r.at_rest && r.l_f > 1.05 * r.l_i, "{r:?}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    for key in [
+        "name",
+        "grains",
+        "packing_fraction",
+        "l_i",
+        "h_i",
+        "aspect_ratio",
+        "tau_c",
+        "l_f",
+        "h_f",
+        "delta_l",
+        "h_f_over_l_i",
+        "stop_time_tc",
+        "at_rest",
+        "dt",
+        "steps",
+        "wall_time_s",
+        "deposition_wall_time_s",
+        "particle_steps_per_s",
+        "energy_budget_error",
+    ] {
+        assert!(json.get(key).is_some(), "summary lacks {key}");
+    }
+    let csv = std::fs::read_to_string(dir.path().join("timeseries.csv")).unwrap();
+    assert!(csv.starts_with("t,t_over_tc,runout,front,height,kinetic,potential,elastic"));
+    let pvd = std::fs::read_to_string(dir.path().join("series.pvd")).unwrap();
+    assert!(pvd.contains("points_000000.vtu") && pvd.contains("grid_000000.vti"));
+    // Energy: the booked total may only fall (numerical dissipation), never rise.
+    let e = r.energy;
+    let total = e.kinetic
+        + e.potential
+        + e.elastic
+        + e.dissipated_plastic
+        + e.dissipated_normal
+        + e.dissipated_friction
+        + e.dissipated_damping;
+    assert!(
+        total <= r.potential_initial * (1.0 + 1e-6),
+        "{total} > {}",
+        r.potential_initial
+    );
+}
+
+/// The `Scale` verbs: `advance(dt)` sub-cycles ⌈dt/Δt⌉ steps and lands on t + dt; a snapshot
+/// restores the state exactly.
+#[test]
+fn scale_advances_in_substeps_and_restores() {
+    use granflow::scale::Scale;
+    let mut mpm = granflow::mpm::bench::column(512, granflow::mpm::ShapeKind::Gimp).unwrap();
+    let dt = mpm.max_dt();
+    let snap = mpm.snapshot();
+    mpm.advance(&(), 10.5 * dt).unwrap();
+    assert_eq!(mpm.step_count(), 11);
+    assert!((Scale::time(&mpm) - 10.5 * dt).abs() < 1e-12 * dt);
+    let moved = mpm.points.pos.clone();
+    mpm.restore(snap);
+    assert_eq!(Scale::time(&mpm), 0.0);
+    assert_ne!(mpm.points.pos, moved);
+    let mut view = granflow::mpm::scale::PointView::default();
+    mpm.observe(&mut view);
+    assert_eq!(view.pos.len(), mpm.points.len());
+}
+
+/// Attachment: a point more than one cell away from the main mass is not part of the run-out
+/// but is the front; a point in a cell touching the mass is attached.
+#[test]
+fn runout_counts_only_points_attached_to_the_main_mass() {
+    let mut mpm = granflow::mpm::bench::column(512, granflow::mpm::ShapeKind::Gimp).unwrap();
+    let h = mpm.grid.h;
+    let s0 = granflow::mpm::run::shape(&mpm);
+    let right = mpm.points.pos.iter().fold(0.0f64, |a, p| a.max(p[0]));
+    // Two cells beyond the mass's last occupied cell: detached.
+    mpm.points.pos.push([right + 2.5 * h, 0.25 * h]);
+    mpm.points.half_size.push(0.25 * h);
+    let s1 = granflow::mpm::run::shape(&mpm);
+    assert_eq!(s1.runout, s0.runout);
+    assert!((s1.front - (right + 2.75 * h)).abs() < 1e-12);
+    // One cell beyond: its cell shares an edge with an occupied cell, so attached.
+    mpm.points.pos.push([right + 1.0 * h, 0.25 * h]);
+    mpm.points.half_size.push(0.25 * h);
+    let s2 = granflow::mpm::run::shape(&mpm);
+    assert!((s2.runout - (right + 1.25 * h)).abs() < 1e-12, "{s2:?}");
+}
+
+/// Coulomb wall: a sliding block decelerates at μg (rigid-body reference).
+#[test]
+fn mpm_friction_sliding_block() {
+    case_passes("mpm-friction");
+}

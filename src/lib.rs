@@ -6,10 +6,11 @@
 //! | scale | module | method |
 //! |---|---|---|
 //! | grain | [`dem`] | discrete elements: disks, spring-dashpot contacts, friction, rolling resistance |
+//! | continuum | [`mpm`] | generalised-interpolation MPM (uGIMP), USF/USL/MUSL, Mohr–Coulomb |
 //! | fluid | [`lbm`] | D2Q9 lattice Boltzmann, BGK / MRT, Smagorinsky LES |
 //!
-//! The GIMPM continuum is planned (see the issues); the fluid and grain solvers, the
-//! scenario format, the output contract and the validation harness are in place.
+//! [`coupling`] links them: partially saturated cells couple DEM grains to the LBM fluid, in
+//! a driver over two [`scale::Scale`]s with sub-cycling.
 //!
 //! All inputs are SI. [`units::Units`] converts between SI and lattice units, with the formula
 //! in each method's documentation.

@@ -339,13 +339,14 @@ fn run_mpm(path: &Path, out: &Path) -> Result<ExitCode> {
     })
     .with_context(|| stopped(path, out))?;
     println!(
-        "done: a = {:.3}, L_f = {:.4} m, (L_f − L_i)/L_i = {:.3}, H_f/L_i = {:.3}, stop at {:.2} τ_c ({}), {} points, {:.1} s wall",
+        "done: a = {:.3}, L_f = {:.4} m, (L_f − L_i)/L_i = {:.3}, H_f/L_i = {:.3}, spreading stopped at {:.2} τ_c, {} at {:.2} τ_c, {} points, {:.1} s wall",
         r.aspect_ratio,
         r.l_f,
         r.delta_l,
         r.h_f_over_l_i,
         r.stop_time_tc,
         if r.at_rest { "at rest" } else { "end time reached" },
+        r.rest_time_tc,
         r.points,
         r.wall_time_s
     );

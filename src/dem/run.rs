@@ -36,14 +36,12 @@ use super::scenario::DemScenario;
 use super::solver::Dem;
 use super::stress::grain_stress;
 use super::walls::Wall;
+use crate::analysis::runout::{spreading_end, STOP_TOLERANCE};
 use crate::io::{write_json, write_vtu_points, CsvWriter, Field, PvdSeries};
 use crate::{Error, Result};
 
 /// Two grains belong to the same mass when their gap is below this fraction of R_i + R_j.
 pub const CONNECT_GAP: f64 = 0.1;
-
-/// Spreading has stopped once the run-out stays within this fraction of L_i of its final value.
-pub const STOP_TOLERANCE: f64 = 0.01;
 
 /// What a collapse run reports (`summary.json`).
 #[derive(Clone, Debug, Serialize)]
@@ -197,20 +195,6 @@ fn shape(dem: &Dem) -> Shape {
         height,
         contacts,
     }
-}
-
-/// End of spreading: the first time after which every run-out in `history` (t, L) stays
-/// within `tol` of the last one.
-fn spreading_end(history: &[(f64, f64)], tol: f64) -> f64 {
-    let Some(&(t_end, l_f)) = history.last() else {
-        return 0.0;
-    };
-    history
-        .iter()
-        .rev()
-        .take_while(|&&(_, l)| (l - l_f).abs() <= tol)
-        .last()
-        .map_or(t_end, |&(t, _)| t)
 }
 
 fn write_frame(
@@ -417,25 +401,4 @@ pub fn run_column_collapse(
     };
     write_json(&out_dir.join("summary.json"), &summary)?;
     Ok(summary)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::spreading_end;
-
-    #[test]
-    fn spreading_ends_when_the_runout_settles() {
-        let h = [
-            (0.0, 1.0),
-            (1.0, 2.0),
-            (2.0, 2.9),
-            (3.0, 3.02),
-            (4.0, 2.99),
-            (5.0, 3.0),
-        ];
-        assert_eq!(spreading_end(&h, 0.05), 3.0);
-        assert_eq!(spreading_end(&h, 0.001), 5.0);
-        assert_eq!(spreading_end(&h, 10.0), 0.0);
-        assert_eq!(spreading_end(&[], 0.1), 0.0);
-    }
 }

@@ -16,9 +16,10 @@
 //! isolated points thrown further are not. The run-out L(t) is the largest x + l_p over the
 //! main mass (the point's domain edge), measured from the back wall; the front is the largest
 //! x + l_p over all points; the height H(t) is the largest y + l_p over the main mass.
-//! The run stops when the kinetic energy has stayed below `rest_kinetic_fraction` × the
-//! initial potential energy above the floor for `rest_duration_tc` τ_c (and t ≥ 1 τ_c), or at
-//! `end_tc` τ_c.
+//! The *stop time* is when spreading ends: the first time after which L(t) stays within
+//! [`STOP_TOLERANCE`] × L_i of L_f (as for the DEM). The run ends when the kinetic energy has
+//! stayed below `rest_kinetic_fraction` × the initial potential energy above the floor for
+//! `rest_duration_tc` τ_c (and t ≥ 1 τ_c; reported as `rest_time_tc`), or at `end_tc` τ_c.
 
 use std::path::Path;
 use std::time::Instant;
@@ -27,6 +28,7 @@ use serde::Serialize;
 
 use super::scenario::MpmScenario;
 use super::solver::{Mpm, MpmEnergy};
+use crate::analysis::runout::{spreading_end, STOP_TOLERANCE};
 use crate::io::{write_json, write_vti, write_vtu_points, CsvWriter, Field, ImageGrid, PvdSeries};
 use crate::{Error, Result};
 
@@ -56,8 +58,11 @@ pub struct MpmCollapseSummary {
     pub delta_l: f64,
     /// H_f/L_i.
     pub h_f_over_l_i: f64,
-    /// Time at which the mass came to rest (start of the rest interval), in τ_c.
+    /// End of spreading, in τ_c: from then on the run-out stays within
+    /// [`STOP_TOLERANCE`] L_i of L_f (the same rule as the DEM's).
     pub stop_time_tc: f64,
+    /// Start of the final rest interval (kinetic-energy criterion), in τ_c.
+    pub rest_time_tc: f64,
     /// Whether the run stopped at rest (false: it reached `end_tc`).
     pub at_rest: bool,
     /// Time step (s).
@@ -321,6 +326,7 @@ pub fn run_column_collapse(
     let rest_limit = ts.rest_kinetic_fraction * e0.potential;
     let (mut rest_since, mut at_rest) = (None::<f64>, false);
     let (mut row, mut frame) = (0u64, 0usize);
+    let mut history = Vec::new();
     let t_run = Instant::now();
     // Relative to the booked dissipation; 0 while almost nothing is dissipated (t ≈ 0, where
     // the ratio would be round-off over round-off).
@@ -337,6 +343,7 @@ pub fn run_column_collapse(
         let e = mpm.energy();
         let s = shape(&mpm);
         let t = mpm.time();
+        history.push((t, s.runout));
         csv.row(&[
             t,
             t / tau_c,
@@ -391,7 +398,8 @@ pub fn run_column_collapse(
         h_f: s.height,
         delta_l: (s.runout - l_i) / l_i,
         h_f_over_l_i: s.height / l_i,
-        stop_time_tc: rest_since.unwrap_or(mpm.time()) / tau_c,
+        stop_time_tc: spreading_end(&history, STOP_TOLERANCE * l_i) / tau_c,
+        rest_time_tc: rest_since.unwrap_or(mpm.time()) / tau_c,
         at_rest,
         dt,
         steps,

@@ -109,6 +109,15 @@ pub fn copy_bandwidth(bytes: usize) -> f64 {
     best
 }
 
+/// Run `f` in a rayon pool of `threads` threads (0: rayon's default, all cores).
+pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> Result<R> + Send) -> Result<R> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::Other(format!("thread pool: {e}")))?
+        .install(f)
+}
+
 /// Run the LBM benchmark on `threads` threads (0: rayon's default).
 pub fn lbm(
     nx: usize,
@@ -124,11 +133,7 @@ pub fn lbm(
             "bench lbm: need nx, ny ≥ 3 and steps, repeats ≥ 1".into(),
         ));
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Error::Other(format!("thread pool: {e}")))?;
-    pool.install(|| {
+    on_threads(threads, || {
         let elem = if f64_ { 8 } else { 4 };
         let copy_gb_s = copy_bandwidth(9 * nx * ny * elem);
         let mut samples = if f64_ {

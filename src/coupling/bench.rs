@@ -131,11 +131,7 @@ pub fn coupled(
              diameter; use fewer grains or more cells"
         )));
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Error::Other(format!("thread pool: {e}")))?;
-    pool.install(|| {
+    crate::bench::on_threads(threads, || {
         if f64_ {
             time::<f64>(nx, ny, grains, steps)
         } else {

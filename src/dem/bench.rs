@@ -97,11 +97,7 @@ pub fn run(grains: usize, steps: u64, threads: usize, repeats: usize) -> Result<
             "bench dem: need grains ≥ 2 and steps, repeats ≥ 1".into(),
         ));
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Error::Other(format!("thread pool: {e}")))?;
-    pool.install(|| {
+    crate::bench::on_threads(threads, || {
         let mut samples = Vec::with_capacity(repeats);
         let (mut contacts, mut builds, mut n) = (0.0, 0.0, 0);
         for r in 0..repeats {

@@ -109,11 +109,7 @@ pub fn mpm(
             "bench mpm: need points ≥ 32 and steps, repeats ≥ 1".into(),
         ));
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Error::Other(format!("thread pool: {e}")))?;
-    pool.install(|| {
+    crate::bench::on_threads(threads, || {
         let mut mpm = column(points, shape)?;
         mpm.steps(20)?;
         let n = mpm.points.len();

@@ -489,7 +489,7 @@ impl Dem {
 
     /// One velocity-Verlet step of size `dt` (see the module documentation).
     pub fn step_dt(&mut self, dt: f64, loads: Option<&ExternalLoads>) {
-        if !self.forces_valid {
+        if !self.forces_valid || self.inv_mass.len() != self.grains.len() {
             self.evaluate_from_scratch(loads);
         }
         self.kick_drift(dt);

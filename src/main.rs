@@ -340,15 +340,15 @@ fn run_mpm(path: &Path, out: &Path) -> Result<ExitCode> {
     .with_context(|| stopped(path, out))?;
     println!(
         "done: a = {:.3}, L_f = {:.4} m, (L_f − L_i)/L_i = {:.3}, H_f/L_i = {:.3}, spreading stopped at {:.2} τ_c, {} at {:.2} τ_c, {} points, {:.1} s wall",
-        r.aspect_ratio,
-        r.l_f,
-        r.delta_l,
-        r.h_f_over_l_i,
-        r.stop_time_tc,
-        if r.at_rest { "at rest" } else { "end time reached" },
-        r.rest_time_tc,
+        r.collapse.aspect_ratio,
+        r.collapse.l_f,
+        r.collapse.delta_l,
+        r.collapse.h_f_over_l_i,
+        r.collapse.stop_time_tc,
+        if r.collapse.at_rest { "at rest" } else { "end time reached" },
+        r.collapse.rest_time_tc,
         r.points,
-        r.wall_time_s
+        r.collapse.wall_time_s
     );
     Ok(ExitCode::SUCCESS)
 }
@@ -401,12 +401,12 @@ fn run_dem(path: &Path, out: &Path) -> Result<ExitCode> {
     .with_context(|| stopped(path, out))?;
     println!(
         "done: a = {:.3}, L_f/L_i − 1 = {:.3}, H_f/L_i = {:.3}, spreading stopped at {:.2} τ_c, {} at {:.2} τ_c, {} grains, packing {:.3}",
-        r.aspect_ratio,
-        r.delta_l,
-        r.h_f_over_l_i,
-        r.stop_time_tc,
-        if r.at_rest { "at rest" } else { "end time reached" },
-        r.rest_time_tc,
+        r.collapse.aspect_ratio,
+        r.collapse.delta_l,
+        r.collapse.h_f_over_l_i,
+        r.collapse.stop_time_tc,
+        if r.collapse.at_rest { "at rest" } else { "end time reached" },
+        r.collapse.rest_time_tc,
         r.grains,
         r.packing_fraction
     );

@@ -137,13 +137,13 @@ fn tiny_collapse_runs_and_writes_outputs() {
     let dir = tempfile::tempdir().unwrap();
     let sum = run_column_collapse(&s, dir.path(), &mut |_, _| {}).unwrap();
     println!("{}", serde_json::to_string_pretty(&sum).unwrap());
-    assert!(sum.at_rest);
-    assert!(sum.l_f > sum.l_i && sum.h_f < sum.h_i * 1.001);
-    assert!(sum.delta_l > 0.0 && sum.delta_l < 5.0);
+    assert!(sum.collapse.at_rest);
+    assert!(sum.collapse.l_f > sum.collapse.l_i && sum.collapse.h_f < sum.collapse.h_i * 1.001);
+    assert!(sum.collapse.delta_l > 0.0 && sum.collapse.delta_l < 5.0);
     assert!(
-        sum.energy_budget_error < 0.01,
+        sum.collapse.energy_budget_error < 0.01,
         "{}",
-        sum.energy_budget_error
+        sum.collapse.energy_budget_error
     );
     for f in [
         "summary.json",

@@ -107,7 +107,8 @@ fn short_collapse_writes_the_output_contract() {
     let s = MpmScenario::from_toml(&text.replace("end_tc = 15.0", "end_tc = 0.5")).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let r = granflow::mpm::run::run_column_collapse(&s, dir.path(), &mut |_, _| {}).unwrap();
-    assert!(!r.at_rest && r.l_f > 1.05 * r.l_i, "{r:?}");
+    let c = &r.collapse;
+    assert!(!c.at_rest && c.l_f > 1.05 * c.l_i, "{r:?}");
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
             .unwrap();

@@ -20,8 +20,8 @@
 //! measured from the left wall; the front is the largest x + R over all grains (it includes
 //! single grains rolling away); the height H(t) is the largest y + R over the main mass. At
 //! rest: L_f, H_f, ΔL = (L_f − L_i)/L_i, H_f/L_i. The *stop time* is when spreading ends:
-//! the first time after which L(t) stays within [`STOP_TOLERANCE`] × L_i of L_f. The run
-//! ends when the kinetic energy has stayed below `rest_kinetic_fraction` × the initial
+//! the first time after which L(t) stays within 1 % of L_i of L_f
+//! ([`crate::analysis::runout::spreading_end`]). The run ends when the kinetic energy has stayed below `rest_kinetic_fraction` × the initial
 //! potential energy above the floor for `rest_duration_tc` τ_c (and t ≥ 1 τ_c; reported as
 //! `rest_time_tc`, which also waits for grains rolling away from the deposit), or at
 //! `end_tc` τ_c.
@@ -36,57 +36,26 @@ use super::scenario::DemScenario;
 use super::solver::Dem;
 use super::stress::grain_stress;
 use super::walls::Wall;
-use crate::analysis::runout::{spreading_end, STOP_TOLERANCE};
+use crate::analysis::runout::{CollapseOutcome, CollapseRecord};
 use crate::io::{write_json, write_vtu_points, CsvWriter, Field, PvdSeries};
 use crate::{Error, Result};
 
 /// Two grains belong to the same mass when their gap is below this fraction of R_i + R_j.
 pub const CONNECT_GAP: f64 = 0.1;
 
-/// What a collapse run reports (`summary.json`).
+/// What a DEM collapse run reports (`summary.json`): the solver-independent outcome and the
+/// DEM's own keys.
 #[derive(Clone, Debug, Serialize)]
 pub struct CollapseSummary {
-    /// Scenario name.
-    pub name: String,
+    /// L_f, ΔL, H_f, stop time, … (the keys every collapse runner writes).
+    #[serde(flatten)]
+    pub collapse: CollapseOutcome,
     /// Number of grains.
     pub grains: usize,
     /// Packing fraction of the deposited column (interior strip).
     pub packing_fraction: f64,
-    /// Initial width L_i (m).
-    pub l_i: f64,
-    /// Deposited height H_i (m).
-    pub h_i: f64,
-    /// Actual aspect ratio a = H_i/L_i.
-    pub aspect_ratio: f64,
-    /// τ_c = √(H_i/g) (s).
-    pub tau_c: f64,
-    /// Final run-out L_f (m).
-    pub l_f: f64,
-    /// Final height H_f (m).
-    pub h_f: f64,
-    /// ΔL = (L_f − L_i)/L_i.
-    pub delta_l: f64,
-    /// H_f/L_i.
-    pub h_f_over_l_i: f64,
-    /// End of spreading, in τ_c: from then on the run-out stays within [`STOP_TOLERANCE`] L_i
-    /// of L_f.
-    pub stop_time_tc: f64,
-    /// Start of the final rest interval (kinetic-energy criterion), in τ_c.
-    pub rest_time_tc: f64,
-    /// Whether the run stopped at rest (false: it reached `end_tc`).
-    pub at_rest: bool,
-    /// Time step (s).
-    pub dt: f64,
-    /// Steps of the collapse.
-    pub steps: u64,
-    /// Wall time of the collapse (s), deposition excluded.
-    pub wall_time_s: f64,
     /// Wall time of the deposition (s).
     pub deposition_wall_time_s: f64,
-    /// Collapse throughput: grains × steps / wall time.
-    pub particle_steps_per_s: f64,
-    /// |E_total(end) − E_total(0)| / dissipated energy.
-    pub energy_budget_error: f64,
 }
 
 /// Main mass, run-out, front, height, and contacts per grain.
@@ -376,28 +345,27 @@ pub fn run_column_collapse(
         )?;
     }
     let (s, e) = last;
-    let steps = dem.step_count();
-    let summary = CollapseSummary {
-        name: scenario.name.clone(),
-        grains: dem.grains.len(),
-        packing_fraction: column.packing_fraction,
+    let collapse = CollapseOutcome::from(CollapseRecord {
+        name: &scenario.name,
         l_i,
         h_i,
-        aspect_ratio: h_i / l_i,
-        tau_c,
-        l_f: s.runout,
+        gravity: gmag,
+        history: &history,
         h_f: s.height,
-        delta_l: (s.runout - l_i) / l_i,
-        h_f_over_l_i: s.height / l_i,
-        stop_time_tc: spreading_end(&history, STOP_TOLERANCE * l_i) / tau_c,
-        rest_time_tc: rest_since.unwrap_or(dem.time()) / tau_c,
+        rest_since,
         at_rest,
+        t_end: dem.time(),
         dt,
-        steps,
+        steps: dem.step_count(),
         wall_time_s,
-        deposition_wall_time_s,
-        particle_steps_per_s: dem.grains.len() as f64 * steps as f64 / wall_time_s.max(1e-9),
+        particles: dem.grains.len(),
         energy_budget_error: budget(&e),
+    });
+    let summary = CollapseSummary {
+        collapse,
+        grains: dem.grains.len(),
+        packing_fraction: column.packing_fraction,
+        deposition_wall_time_s,
     };
     write_json(&out_dir.join("summary.json"), &summary)?;
     Ok(summary)

@@ -17,7 +17,7 @@
 //! main mass (the point's domain edge), measured from the back wall; the front is the largest
 //! x + l_p over all points; the height H(t) is the largest y + l_p over the main mass.
 //! The *stop time* is when spreading ends: the first time after which L(t) stays within
-//! [`STOP_TOLERANCE`] × L_i of L_f (as for the DEM). The run ends when the kinetic energy has
+//! 1 % of L_i of L_f, as for the DEM ([`crate::analysis::runout::spreading_end`]). The run ends when the kinetic energy has
 //! stayed below `rest_kinetic_fraction` × the initial potential energy above the floor for
 //! `rest_duration_tc` τ_c (and t ≥ 1 τ_c; reported as `rest_time_tc`), or at `end_tc` τ_c.
 
@@ -28,56 +28,24 @@ use serde::Serialize;
 
 use super::scenario::MpmScenario;
 use super::solver::{Mpm, MpmEnergy};
-use crate::analysis::runout::{spreading_end, STOP_TOLERANCE};
+use crate::analysis::runout::{CollapseOutcome, CollapseRecord};
 use crate::io::{write_json, write_vti, write_vtu_points, CsvWriter, Field, ImageGrid, PvdSeries};
 use crate::{Error, Result};
 
-/// What an MPM collapse run reports (`summary.json`): the keys of the DEM's
-/// `CollapseSummary` (so the two compare directly) and MPM-specific ones after them.
+/// What an MPM collapse run reports (`summary.json`): the solver-independent outcome (the
+/// same keys as the DEM's, so the two compare directly), the DEM's other keys where they have
+/// a meaning, and MPM-specific ones.
 #[derive(Clone, Debug, Serialize)]
 pub struct MpmCollapseSummary {
-    /// Scenario name.
-    pub name: String,
+    /// L_f, ΔL, H_f, stop time, … (the keys every collapse runner writes).
+    #[serde(flatten)]
+    pub collapse: CollapseOutcome,
     /// DEM key: here the number of material points.
     pub grains: usize,
     /// DEM key: not defined for the continuum (null).
     pub packing_fraction: Option<f64>,
-    /// Initial width L_i (m).
-    pub l_i: f64,
-    /// Initial height H_i (m).
-    pub h_i: f64,
-    /// a = H_i/L_i.
-    pub aspect_ratio: f64,
-    /// τ_c = √(H_i/g) (s).
-    pub tau_c: f64,
-    /// Final run-out L_f (m).
-    pub l_f: f64,
-    /// Final height H_f (m).
-    pub h_f: f64,
-    /// ΔL = (L_f − L_i)/L_i.
-    pub delta_l: f64,
-    /// H_f/L_i.
-    pub h_f_over_l_i: f64,
-    /// End of spreading, in τ_c: from then on the run-out stays within
-    /// [`STOP_TOLERANCE`] L_i of L_f (the same rule as the DEM's).
-    pub stop_time_tc: f64,
-    /// Start of the final rest interval (kinetic-energy criterion), in τ_c.
-    pub rest_time_tc: f64,
-    /// Whether the run stopped at rest (false: it reached `end_tc`).
-    pub at_rest: bool,
-    /// Time step (s).
-    pub dt: f64,
-    /// Steps of the collapse.
-    pub steps: u64,
-    /// Wall time of the collapse (s).
-    pub wall_time_s: f64,
     /// DEM key (deposition): 0, the MPM column is built directly.
     pub deposition_wall_time_s: f64,
-    /// Throughput: points × steps / wall time.
-    pub particle_steps_per_s: f64,
-    /// |E_total(end) − E_total(0)| / booked dissipation (the scheme's own numerical
-    /// dissipation shows here).
-    pub energy_budget_error: f64,
     /// `"mpm"`.
     pub solver: String,
     /// Number of material points.
@@ -386,27 +354,27 @@ pub fn run_column_collapse(
     let (s, e) = last;
     let steps = mpm.step_count();
     let n = mpm.points.len();
-    let summary = MpmCollapseSummary {
-        name: scenario.name.clone(),
-        grains: n,
-        packing_fraction: None,
+    let collapse = CollapseOutcome::from(CollapseRecord {
+        name: &scenario.name,
         l_i,
         h_i,
-        aspect_ratio: h_i / l_i,
-        tau_c,
-        l_f: s.runout,
+        gravity: scenario.gravity,
+        history: &history,
         h_f: s.height,
-        delta_l: (s.runout - l_i) / l_i,
-        h_f_over_l_i: s.height / l_i,
-        stop_time_tc: spreading_end(&history, STOP_TOLERANCE * l_i) / tau_c,
-        rest_time_tc: rest_since.unwrap_or(mpm.time()) / tau_c,
+        rest_since,
         at_rest,
+        t_end: mpm.time(),
         dt,
         steps,
         wall_time_s,
-        deposition_wall_time_s: 0.0,
-        particle_steps_per_s: n as f64 * steps as f64 / wall_time_s.max(1e-9),
+        particles: n,
         energy_budget_error: budget(&e),
+    });
+    let summary = MpmCollapseSummary {
+        collapse,
+        grains: n,
+        packing_fraction: None,
+        deposition_wall_time_s: 0.0,
         solver: "mpm".into(),
         points: n,
         cells: [mpm.grid.nx, mpm.grid.ny],

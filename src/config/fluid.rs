@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::positive;
 use crate::lbm::{CollisionModel, Edge, Edges, MrtRates, Obstacle, Shape};
 use crate::units::{Units, CS2};
 use crate::{Error, Result};
@@ -269,17 +270,6 @@ pub struct Derived {
 
 /// Largest lattice Mach number `check` accepts.
 pub const MAX_MACH: f64 = 0.3;
-
-fn positive(field: &str, v: f64) -> Result<()> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::config(
-            field,
-            format!("must be a positive number, got {v}"),
-        ))
-    }
-}
 
 fn whole_cells(field: &str, size: f64, dx: f64) -> Result<usize> {
     let n = size / dx;

@@ -25,6 +25,30 @@ impl Scenario {
     }
 }
 
+/// Refuse `v` unless it is finite and > 0, naming `field` (the scenario key).
+pub(crate) fn positive(field: &str, v: f64) -> Result<()> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::config(
+            field,
+            format!("must be a finite positive number (> 0), got {v}"),
+        ))
+    }
+}
+
+/// Refuse `v` unless it is finite and ≥ 0, naming `field` (the scenario key).
+pub(crate) fn non_negative(field: &str, v: f64) -> Result<()> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(Error::config(
+            field,
+            format!("must be finite and ≥ 0, got {v}"),
+        ))
+    }
+}
+
 /// Parse TOML text into a scenario type; the error carries the parser's message, which names
 /// the line and the key (unknown, missing or mistyped).
 pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T> {

@@ -250,6 +250,36 @@ impl ContactState {
     }
 }
 
+/// A contact that began or ended inside the step: the difference **F**_{k+1} − **F**^end of
+/// its force on grain `i` ([F_x, F_y, torque on i, torque on j]; −F on `j`), added to the
+/// force arrays after the second half-kick so the next step starts from the true force.
+#[derive(Clone, Copy, Debug)]
+pub struct Event {
+    /// Grain i.
+    pub i: u32,
+    /// Grain j, or `u32::MAX` for a wall.
+    pub j: u32,
+    /// The difference on i.
+    pub d: [f64; 4],
+}
+
+impl Event {
+    /// Add the difference to the force arrays of `g` (−F on j, its own torque).
+    #[inline]
+    pub fn apply(&self, g: &mut super::grains::Grains) {
+        let (i, d) = (self.i as usize, self.d);
+        g.fx[i] += d[0];
+        g.fy[i] += d[1];
+        g.torque[i] += d[2];
+        if self.j != u32::MAX {
+            let j = self.j as usize;
+            g.fx[j] -= d[0];
+            g.fy[j] -= d[1];
+            g.torque[j] += d[3];
+        }
+    }
+}
+
 /// Kinematics of one contact at the end of a step, as the force loop sees it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Motion {

@@ -22,6 +22,7 @@ use serde::{Deserialize, Serialize};
 use super::contact::ContactParams;
 use super::packing::{ColumnSpec, SizeDistribution};
 use super::solver::DemParams;
+use crate::config::positive;
 use crate::{Error, Result};
 
 /// A DEM column-collapse scenario, as read from TOML. All values SI.
@@ -171,17 +172,6 @@ pub struct DerivedDem {
     pub target_height: f64,
     /// Target τ_c = √(a L_i/g) (s); the run uses the deposited height's.
     pub target_tau_c: f64,
-}
-
-fn positive(field: &str, v: f64) -> Result<()> {
-    if v > 0.0 && v.is_finite() {
-        Ok(())
-    } else {
-        Err(Error::config(
-            field,
-            format!("must be finite and > 0, got {v}"),
-        ))
-    }
 }
 
 impl DemScenario {

@@ -29,22 +29,10 @@
 //!
 //! The loop is serial (polygon systems are small here); its cost is dominated by rapier.
 
-use super::contact::{ContactOut, ContactState, Law, Motion};
+use super::contact::{ContactOut, ContactState, Event, Law, Motion};
 use super::detect_rapier::{Contact, Coverage, RapierDetector};
 use super::grains::Grains;
 use super::walls::Wall;
-
-/// An onset/end difference **F**_{k+1} − **F**^end to add after the second half-kick:
-/// [F_x on i, F_y on i, torque on i, torque on j]; −F on j; `j == u32::MAX` for a wall.
-#[derive(Clone, Copy, Debug)]
-pub struct ShapeEvent {
-    /// Grain i.
-    pub i: u32,
-    /// Grain j, or `u32::MAX` for a wall.
-    pub j: u32,
-    /// Difference.
-    pub d: [f64; 4],
-}
 
 /// Sums of one evaluation (energies of the springs now, dissipation over the step).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -77,7 +65,7 @@ pub struct ShapeContacts {
     pub force: Vec<[f64; 2]>,
     old: Vec<Contact>,
     old_state: Vec<ContactState>,
-    events: Vec<ShapeEvent>,
+    events: Vec<Event>,
     /// Sum per grain of this evaluation's forces [F_x, F_y, torque] (the second half-kick's
     /// F^end, like the pair lists' `out`).
     per_grain: Vec<[f64; 3]>,
@@ -282,7 +270,7 @@ impl ShapeContacts {
             if r.event {
                 let (dn, dt, dm) = (st.f_n - an, st.f_t - at, st.m_r - ar);
                 let d = [-dn * nx + dt * tx, -dn * ny + dt * ty];
-                self.events.push(ShapeEvent {
+                self.events.push(Event {
                     i: c.i,
                     j,
                     d: [d[0], d[1], cross(ri, d) + dm, -cross(rj, d) - dm],
@@ -308,16 +296,7 @@ impl ShapeContacts {
     /// Turn the forces of onset/end steps from **F**^end into **F**_{k+1} (after the kick).
     pub fn apply_events(&self, g: &mut Grains) {
         for ev in &self.events {
-            let (i, d) = (ev.i as usize, ev.d);
-            g.fx[i] += d[0];
-            g.fy[i] += d[1];
-            g.torque[i] += d[2];
-            if ev.j != u32::MAX {
-                let j = ev.j as usize;
-                g.fx[j] -= d[0];
-                g.fy[j] -= d[1];
-                g.torque[j] += d[3];
-            }
+            ev.apply(g);
         }
     }
 

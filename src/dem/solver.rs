@@ -28,7 +28,7 @@
 
 use rayon::prelude::*;
 
-use super::contact::{self, ContactOut, ContactParams, Law, Motion};
+use super::contact::{self, ContactOut, ContactParams, Event, Law, Motion};
 use super::detect_rapier::RapierDetector;
 use super::energy::Energy;
 use super::grains::Grains;
@@ -126,16 +126,6 @@ pub struct ExternalLoads {
     pub fy: Vec<f64>,
     /// Torque per grain.
     pub torque: Vec<f64>,
-}
-
-/// A contact that began or ended inside the step: the difference **F**_{k+1} − **F**^end of
-/// its force on grain `i` ([F_x, F_y, torque on i, torque on j]; −F on `j`), added to the
-/// force arrays after the second half-kick. `j == u32::MAX` for a wall.
-#[derive(Clone, Copy, Debug)]
-struct Event {
-    i: u32,
-    j: u32,
-    d: [f64; 4],
 }
 
 /// Per-chunk sums of one force evaluation.
@@ -580,16 +570,7 @@ impl Dem {
             &self.wall_events[..self.event_chunks[1]],
         ];
         for ev in lists.into_iter().flatten().flatten() {
-            let (i, d) = (ev.i as usize, ev.d);
-            g.fx[i] += d[0];
-            g.fy[i] += d[1];
-            g.torque[i] += d[2];
-            if ev.j != u32::MAX {
-                let j = ev.j as usize;
-                g.fx[j] -= d[0];
-                g.fy[j] -= d[1];
-                g.torque[j] += d[3];
-            }
+            ev.apply(g);
         }
         if let Some(sc) = &self.shapes {
             sc.apply_events(g);

@@ -23,6 +23,7 @@ use super::material::{LinearElastic, MaterialModel, MohrCoulomb};
 use super::points::Points;
 use super::shape::ShapeKind;
 use super::solver::{cfl_step, Mpm, MpmParams, Scheme};
+use crate::config::{non_negative, positive};
 use crate::{Error, Result};
 
 /// An MPM column-collapse scenario, as read from TOML. All values SI (angles in degrees).
@@ -161,28 +162,6 @@ pub struct DerivedMpm {
     pub dt_cfl: f64,
     /// P-wave speed c = √((K + 4G/3)/ρ) (m/s).
     pub wave_speed: f64,
-}
-
-fn positive(field: &str, v: f64) -> Result<()> {
-    if v > 0.0 && v.is_finite() {
-        Ok(())
-    } else {
-        Err(Error::config(
-            field,
-            format!("must be finite and > 0, got {v}"),
-        ))
-    }
-}
-
-fn non_negative(field: &str, v: f64) -> Result<()> {
-    if v >= 0.0 && v.is_finite() {
-        Ok(())
-    } else {
-        Err(Error::config(
-            field,
-            format!("must be finite and ≥ 0, got {v}"),
-        ))
-    }
 }
 
 fn check_wall(field: &str, w: &WallKind) -> Result<()> {

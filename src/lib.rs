@@ -42,6 +42,7 @@ pub mod lbm;
 pub mod mpm;
 pub mod run;
 pub mod scale;
+pub mod sweep;
 pub mod units;
 pub mod validate;
 

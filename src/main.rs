@@ -51,6 +51,18 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         figures: Option<PathBuf>,
     },
+    /// Run a column-collapse sweep (cases in parallel, resumable) and write sweep.csv,
+    /// fits.json and the figures.
+    Sweep {
+        /// Sweep file (TOML): base scenario per solver and the values to vary.
+        sweep: PathBuf,
+        /// Output folder: one sub-folder per case, plus the tables and figures.
+        #[arg(long)]
+        out: PathBuf,
+        /// Cases run at the same time (0: one per core).
+        #[arg(long, default_value_t = 0)]
+        jobs: usize,
+    },
     /// Throughput benchmarks.
     Bench {
         #[command(subcommand)]
@@ -184,7 +196,61 @@ fn real_main() -> Result<ExitCode> {
             full,
             figures,
         } => validate_cmd(&case, json, full, figures.as_deref()),
+        Command::Sweep { sweep, out, jobs } => sweep_cmd(&sweep, &out, jobs),
         Command::Bench { which } => bench(which),
+    }
+}
+
+fn sweep_cmd(path: &Path, out: &Path, jobs: usize) -> Result<ExitCode> {
+    let r = granflow::sweep::run_sweep(path, out, jobs)?;
+    for g in &r.fits.groups {
+        let with: String = g.with.iter().map(|(p, v)| format!(" {p}={v}")).collect();
+        match &g.law {
+            Some(l) => println!(
+                "{}{with}: ΔL = {:.3}a (a < {:.2}), {:.3}a^{:.3} (±{:.3}) above; {} cases",
+                g.solver,
+                l.small.lambda,
+                l.crossover,
+                l.large.lambda,
+                l.large.alpha,
+                l.large.alpha_err.unwrap_or(f64::NAN),
+                g.points.len()
+            ),
+            None => println!(
+                "{}{with}: {} cases (too few to fit)",
+                g.solver,
+                g.points.len()
+            ),
+        }
+    }
+    for c in &r.fits.mpm_vs_dem {
+        println!(
+            "a = {:.2}: ΔL DEM {:.3}, MPM {:.3} ({:+.1} %)",
+            c.a,
+            c.dem,
+            c.mpm,
+            100.0 * c.mpm_excess
+        );
+    }
+    let failed: Vec<_> = r.failed().collect();
+    println!(
+        "{} cases, {} reused, {} failed -> {}",
+        r.cases.len(),
+        r.cases.iter().filter(|c| c.reused).count(),
+        failed.len(),
+        out.display()
+    );
+    if failed.is_empty() {
+        Ok(ExitCode::SUCCESS)
+    } else {
+        for c in failed {
+            eprintln!(
+                "failed: {}: {}",
+                c.case.name,
+                c.outcome.as_ref().unwrap_err()
+            );
+        }
+        Ok(ExitCode::FAILURE)
     }
 }
 

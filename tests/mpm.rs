@@ -139,20 +139,16 @@ fn short_collapse_writes_the_output_contract() {
     assert!(csv.starts_with("t,t_over_tc,runout,front,height,kinetic,potential,elastic"));
     let pvd = std::fs::read_to_string(dir.path().join("series.pvd")).unwrap();
     assert!(pvd.contains("points_000000.vtu") && pvd.contains("grid_000000.vti"));
-    // Energy: the booked total may only fall (numerical dissipation), never rise.
-    let e = r.energy;
-    let total = e.kinetic
-        + e.potential
-        + e.elastic
-        + e.dissipated_plastic
-        + e.dissipated_normal
-        + e.dissipated_friction
-        + e.dissipated_damping;
+    // Energy: what is booked (kinetic, elastic, dissipated) may not exceed the potential
+    // energy released (the rest is the scheme's numerical dissipation), and is most of it.
+    let e = r.collapse.energy;
+    let booked = e.kinetic + e.elastic + e.dissipated();
     assert!(
-        total <= r.potential_initial * (1.0 + 1e-6),
-        "{total} > {}",
-        r.potential_initial
+        booked <= e.potential_released * (1.0 + 1e-6) && booked > 0.5 * e.potential_released,
+        "{booked} vs {}",
+        e.potential_released
     );
+    assert_eq!(e.rolling, 0.0);
 }
 
 /// The `Scale` verbs: `advance(dt)` sub-cycles ⌈dt/Δt⌉ steps and lands on t + dt; a snapshot

@@ -1,7 +1,7 @@
 //! Run-out history and outcome of a column collapse, shared by the DEM and MPM runners so both
 //! report the same quantities under the same keys (`summary.json`).
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Spreading has stopped once the run-out stays within this fraction of L_i of its final value.
 pub const STOP_TOLERANCE: f64 = 0.01;
@@ -23,7 +23,7 @@ pub fn spreading_end(history: &[(f64, f64)], tol: f64) -> f64 {
 /// What every collapse run reports, whatever the solver: the common part of `summary.json`
 /// (each runner adds its own keys beside these, through `#[serde(flatten)]`). Definitions:
 /// REFERENCES, granular column collapse; τ_c = √(H_i/g).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CollapseOutcome {
     /// Scenario name.
     pub name: String,
@@ -60,6 +60,50 @@ pub struct CollapseOutcome {
     pub particle_steps_per_s: f64,
     /// |E_total(end) − E_total(0)| / dissipated energy.
     pub energy_budget_error: f64,
+    /// Where the released potential energy went, at the end of the run.
+    pub energy: EnergyBudget,
+}
+
+/// The energy released by a collapse and where it went, at one instant (cumulative since the
+/// release): ΔE_p = K + E_el + D_collision + D_friction + D_rolling + D_plastic + D_damping
+/// plus the scheme's own numerical dissipation. Units: J for the DEM (disks of the
+/// scenario's thickness), J per metre of depth for the plane-strain MPM; compare solvers
+/// through [`EnergyBudget::share`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct EnergyBudget {
+    /// Potential energy released, E_p(0) − E_p(t).
+    pub potential_released: f64,
+    /// Kinetic energy (translational + rotational).
+    pub kinetic: f64,
+    /// Elastic energy stored (contact springs; the continuum's strain energy).
+    pub elastic: f64,
+    /// Dissipated in collisions: the DEM's normal dashpots; the MPM's inelastic wall impacts.
+    pub collision: f64,
+    /// Dissipated by friction: the DEM's tangential dashpots and Coulomb sliding (grains and
+    /// walls); the MPM's wall friction.
+    pub friction: f64,
+    /// Dissipated by rolling resistance (DEM).
+    pub rolling: f64,
+    /// Dissipated by plastic flow (MPM, Mohr–Coulomb).
+    pub plastic: f64,
+    /// Dissipated by artificial damping (DEM global, MPM local damping).
+    pub damping: f64,
+}
+
+impl EnergyBudget {
+    /// `part` as a fraction of the potential energy released (0 before anything is released).
+    pub fn share(&self, part: f64) -> f64 {
+        if self.potential_released > 0.0 {
+            part / self.potential_released
+        } else {
+            0.0
+        }
+    }
+
+    /// Everything booked as dissipated.
+    pub fn dissipated(&self) -> f64 {
+        self.collision + self.friction + self.rolling + self.plastic + self.damping
+    }
 }
 
 /// What a runner measured, from which [`CollapseOutcome`] derives the rest.
@@ -93,6 +137,8 @@ pub struct CollapseRecord<'a> {
     pub particles: usize,
     /// Energy budget error (see [`CollapseOutcome::energy_budget_error`]).
     pub energy_budget_error: f64,
+    /// Energy released and dissipated by the end.
+    pub energy: EnergyBudget,
 }
 
 impl From<CollapseRecord<'_>> for CollapseOutcome {
@@ -117,6 +163,7 @@ impl From<CollapseRecord<'_>> for CollapseOutcome {
             wall_time_s: r.wall_time_s,
             particle_steps_per_s: r.particles as f64 * r.steps as f64 / r.wall_time_s.max(1e-9),
             energy_budget_error: r.energy_budget_error,
+            energy: r.energy,
         }
     }
 }

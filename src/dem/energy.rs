@@ -14,6 +14,8 @@
 
 use serde::Serialize;
 
+use crate::analysis::runout::EnergyBudget;
+
 /// Energies of a DEM system at one instant (state terms) and since the start (cumulative terms).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Energy {
@@ -68,5 +70,20 @@ impl Energy {
     /// The conserved total: mechanical + dissipated − external work.
     pub fn total(&self) -> f64 {
         self.mechanical() + self.dissipated() - self.work_external
+    }
+
+    /// Where the potential energy released since `start` went (collisions = normal dashpots,
+    /// friction = tangential dashpots and sliding, rolling, global damping).
+    pub fn budget(&self, start: &Energy) -> EnergyBudget {
+        EnergyBudget {
+            potential_released: start.potential - self.potential,
+            kinetic: self.kinetic_total(),
+            elastic: self.elastic(),
+            collision: self.dissipated_normal - start.dissipated_normal,
+            friction: self.dissipated_friction - start.dissipated_friction,
+            rolling: self.dissipated_rolling - start.dissipated_rolling,
+            plastic: 0.0,
+            damping: self.dissipated_global - start.dissipated_global,
+        }
     }
 }

@@ -360,6 +360,7 @@ pub fn run_column_collapse(
         wall_time_s,
         particles: dem.grains.len(),
         energy_budget_error: budget(&e),
+        energy: e.budget(&e0),
     });
     let summary = CollapseSummary {
         collapse,

@@ -19,6 +19,47 @@ pub(crate) fn format_f64(x: f64) -> String {
     }
 }
 
+/// A numeric CSV table read back (e.g. a run's `timeseries.csv`): column names and rows.
+#[derive(Clone, Debug, Default)]
+pub struct CsvTable {
+    /// Column names from the header line.
+    pub header: Vec<String>,
+    /// Rows of numbers (a field that does not parse reads as NaN).
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl CsvTable {
+    /// Reads `path`: a header line, then comma-separated numbers.
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let mut lines = text.lines();
+        let header = lines
+            .next()
+            .map(|h| h.split(',').map(str::to_owned).collect())
+            .unwrap_or_default();
+        let rows = lines
+            .filter(|l| !l.is_empty())
+            .map(|l| {
+                l.split(',')
+                    .map(|v| v.parse().unwrap_or(f64::NAN))
+                    .collect()
+            })
+            .collect();
+        Ok(CsvTable { header, rows })
+    }
+
+    /// The values of column `name` (`None` if there is no such column).
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let k = self.header.iter().position(|h| h == name)?;
+        Some(
+            self.rows
+                .iter()
+                .map(|r| r.get(k).copied().unwrap_or(f64::NAN))
+                .collect(),
+        )
+    }
+}
+
 /// A CSV file written one row at a time, e.g. `timeseries.csv`.
 ///
 /// The header is written on [`create`](CsvWriter::create); each [`row`](CsvWriter::row) must

@@ -14,8 +14,8 @@ pub mod pvd;
 pub mod vtk;
 
 pub use atomic::{write_atomic, write_atomic_bytes};
-pub use csv::CsvWriter;
+pub use csv::{CsvTable, CsvWriter};
 pub use json::write_json;
-pub use plot::write_svg;
+pub use plot::{write_png, write_svg};
 pub use pvd::{PvdEntry, PvdSeries};
 pub use vtk::{write_vti, write_vtu_points, Field, FieldData, ImageGrid};

@@ -34,6 +34,49 @@ pub fn write_svg(plot: &Plot, path: &Path) -> Result<()> {
     crate::io::write_atomic(path, |w| w.write_all(svg.as_bytes()))
 }
 
+/// Renders `plot` as a PNG file at `path` (atomic write): the SVG of [`render_svg`]
+/// rasterised by resvg at twice its size, text set in the system's fonts (none installed:
+/// the text is left out).
+pub fn write_png(plot: &Plot, path: &Path) -> Result<()> {
+    use resvg::{tiny_skia, usvg};
+    let svg = render_svg(plot)?;
+    let fail = |e: String| Error::Other(format!("figure `{}` as PNG: {e}", plot.name));
+    let mut options = usvg::Options::default();
+    let fonts = options.fontdb_mut();
+    fonts.load_system_fonts();
+    // The SVG asks for `sans-serif`: map it to an installed sans face (DejaVu Sans on Debian).
+    let family = fonts
+        .faces()
+        .flat_map(|f| f.families.iter().map(|(name, _)| name.clone()))
+        .min_by_key(|name| {
+            (
+                !name.contains("Sans"),
+                !name.starts_with("DejaVu"),
+                name.len(),
+            )
+        });
+    if let Some(family) = family {
+        fonts.set_sans_serif_family(family);
+    }
+    let tree = usvg::Tree::from_str(&svg, &options).map_err(|e| fail(e.to_string()))?;
+    let scale = 2.0;
+    let size = tree
+        .size()
+        .to_int_size()
+        .scale_by(scale)
+        .ok_or_else(|| fail("size".into()))?;
+    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height())
+        .ok_or_else(|| fail("empty image".into()))?;
+    pixmap.fill(tiny_skia::Color::WHITE);
+    resvg::render(
+        &tree,
+        tiny_skia::Transform::from_scale(scale, scale),
+        &mut pixmap.as_mut(),
+    );
+    let png = pixmap.encode_png().map_err(|e| fail(e.to_string()))?;
+    crate::io::write_atomic(path, |w| w.write_all(&png))
+}
+
 /// Renders `plot` into an SVG document in memory.
 pub fn render_svg(plot: &Plot) -> Result<String> {
     let fail = |e: String| Error::Other(format!("figure `{}`: {e}", plot.name));
@@ -68,9 +111,11 @@ pub fn render_svg(plot: &Plot) -> Result<String> {
     // The legend goes into the emptiest corner; if every corner holds data, the vertical range
     // grows at the top to make room for it there (unless the range is fixed).
     let labels = plot.series.iter().map(|s| s.label.len()).max().unwrap_or(0);
+    // Series with an empty label have no legend entry.
+    let entries = plot.series.iter().filter(|s| !s.label.is_empty()).count();
     let legend = (
         ((6 * labels + 50) as f64 / 540.0).min(0.9),
-        (0.05 + 0.065 * plot.series.len() as f64).min(0.8),
+        (0.05 + 0.065 * entries as f64).min(0.8),
     );
     let (mut corner, crowded) = legend_corner(&pts, x, y, (plot.log_x, plot.log_y), legend);
     if crowded > 0 && plot.y_range.is_none() {
@@ -343,15 +388,18 @@ fn draw(
         .map_err(|e| err(&e))?;
     let mut markers = 0;
     for (k, (s, pts)) in plot.series.iter().zip(series).enumerate() {
-        let colour = COLOURS[k % COLOURS.len()];
+        let colour = COLOURS[s.colour.unwrap_or(k) % COLOURS.len()];
         match s.style {
             Style::Line => {
                 let line = colour.stroke_width(2);
-                chart
+                let drawn = chart
                     .draw_series(LineSeries::new(pts.iter().copied(), line))
-                    .map_err(|e| err(&e))?
-                    .label(s.label.as_str())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
+                    .map_err(|e| err(&e))?;
+                if !s.label.is_empty() {
+                    drawn
+                        .label(s.label.as_str())
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
+                }
             }
             Style::Markers => {
                 // Shapes differ between marker series so that coinciding points stay visible.
@@ -362,16 +410,17 @@ fn draw(
                     colour.stroke_width(2),
                 );
                 macro_rules! shape {
-                    ($p:ident => $e:expr) => {
-                        chart
+                    ($p:ident => $e:expr) => {{
+                        let drawn = chart
                             .draw_series(pts.iter().map(|&$p| $e))
-                            .map_err(|e| err(&e))?
-                            .label(s.label.as_str())
-                            .legend(move |(x, y)| {
+                            .map_err(|e| err(&e))?;
+                        if !s.label.is_empty() {
+                            drawn.label(s.label.as_str()).legend(move |(x, y)| {
                                 let $p = (x + 10, y);
                                 $e
-                            })
-                    };
+                            });
+                        }
+                    }};
                 }
                 match markers % 4 {
                     0 => shape!(p => Circle::new(p, 3, fill)),

@@ -54,43 +54,6 @@ pub struct MpmCollapseSummary {
     pub cells: [usize; 2],
     /// Cell size h (m).
     pub cell_size: f64,
-    /// Initial potential energy above the floor (J per m).
-    pub potential_initial: f64,
-    /// Energies at the end (J per m).
-    pub energy: EnergyOut,
-}
-
-/// Energies written to the summary.
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct EnergyOut {
-    /// Kinetic.
-    pub kinetic: f64,
-    /// Potential above the floor.
-    pub potential: f64,
-    /// Elastic.
-    pub elastic: f64,
-    /// Plastic dissipation.
-    pub dissipated_plastic: f64,
-    /// Removed by the walls' normal constraint.
-    pub dissipated_normal: f64,
-    /// Wall friction.
-    pub dissipated_friction: f64,
-    /// Local damping.
-    pub dissipated_damping: f64,
-}
-
-impl From<MpmEnergy> for EnergyOut {
-    fn from(e: MpmEnergy) -> Self {
-        EnergyOut {
-            kinetic: e.kinetic,
-            potential: e.potential,
-            elastic: e.elastic,
-            dissipated_plastic: e.plastic,
-            dissipated_normal: e.boundary_normal,
-            dissipated_friction: e.boundary_friction,
-            dissipated_damping: e.damping,
-        }
-    }
 }
 
 /// Run-out, front and height (see the module doc).
@@ -369,6 +332,7 @@ pub fn run_column_collapse(
         wall_time_s,
         particles: n,
         energy_budget_error: budget(&e),
+        energy: e.budget(&e0),
     });
     let summary = MpmCollapseSummary {
         collapse,
@@ -379,8 +343,6 @@ pub fn run_column_collapse(
         points: n,
         cells: [mpm.grid.nx, mpm.grid.ny],
         cell_size: mpm.grid.h,
-        potential_initial: e0.potential,
-        energy: e.into(),
     };
     write_json(&out_dir.join("summary.json"), &summary)?;
     Ok(summary)

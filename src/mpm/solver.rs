@@ -112,6 +112,21 @@ impl MpmEnergy {
     pub fn total(&self) -> f64 {
         self.mechanical() + self.dissipated()
     }
+
+    /// Where the potential energy released since `start` went (collision = inelastic wall
+    /// impacts, friction = wall friction, plastic flow, local damping).
+    pub fn budget(&self, start: &MpmEnergy) -> crate::analysis::runout::EnergyBudget {
+        crate::analysis::runout::EnergyBudget {
+            potential_released: start.potential - self.potential,
+            kinetic: self.kinetic,
+            elastic: self.elastic,
+            collision: self.boundary_normal - start.boundary_normal,
+            friction: self.boundary_friction - start.boundary_friction,
+            rolling: 0.0,
+            plastic: self.plastic - start.plastic,
+            damping: self.damping - start.damping,
+        }
+    }
 }
 
 /// Columns per stripe of the parallel P2G.

@@ -118,12 +118,14 @@ pub enum Style {
 /// One curve or point set of a [`Plot`].
 #[derive(Clone, Debug, Serialize)]
 pub struct Series {
-    /// Legend entry.
+    /// Legend entry (empty: none).
     pub label: String,
     /// (x, y) data.
     pub points: Vec<(f64, f64)>,
     /// Line or markers.
     pub style: Style,
+    /// Palette index of the colour; `None`: the series' position in the plot.
+    pub colour: Option<usize>,
 }
 
 impl Series {
@@ -133,6 +135,7 @@ impl Series {
             label: label.into(),
             points,
             style: Style::Line,
+            colour: None,
         }
     }
 
@@ -142,7 +145,14 @@ impl Series {
             label: label.into(),
             points,
             style: Style::Markers,
+            colour: None,
         }
+    }
+
+    /// Draw in palette colour `k` (so related series can share a colour).
+    pub fn coloured(mut self, k: usize) -> Self {
+        self.colour = Some(k);
+        self
     }
 
     /// Keep at most `max` points (≥ 2) by taking every k-th one, always keeping the last, so

@@ -1,0 +1,347 @@
+//! The sweep file (`granflow sweep <sweep.toml>`): a base scenario per solver and the fields to
+//! vary, expanded into one fully resolved scenario per case.
+//!
+//! ```toml
+//! name = "sweep_quick"
+//! description = "…"
+//!
+//! [solvers]                    # base scenarios, relative to this file
+//! dem = "dem_a2.toml"
+//! mpm = "mpm_a2.toml"
+//!
+//! [set]                        # optional: fixed overrides for every case
+//! "dem.time.end_tc" = 12.0
+//!
+//! [[vary]]                     # one dimension; its lists vary together (same length)
+//! "column.aspect_ratio" = [0.5, 1, 2]
+//! "column.width" = [0.055, 0.039, 0.031]
+//!
+//! [[vary]]                     # a second dimension: the cases are the Cartesian product
+//! "dem.grain_contact.friction" = [0.3, 0.53]
+//! ```
+//!
+//! A key is a dotted path to a field of the base scenario (`column.aspect_ratio`), or the same
+//! prefixed by a solver name (`dem.grain_contact.friction`) to apply to that solver only. The
+//! field must exist in the base (so a misspelt path is an error, not a silently ignored
+//! setting), and the value must be a scalar of the same kind (a number for a number). Each
+//! case's scenario is then read by the solver's own parser, with its checks.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+use toml::Value;
+
+use crate::{Error, Result};
+
+/// The solvers a sweep can run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Solver {
+    /// The DEM column collapse (`dem::run`).
+    Dem,
+    /// The MPM column collapse (`mpm::run`).
+    Mpm,
+}
+
+impl Solver {
+    /// `"dem"` or `"mpm"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Solver::Dem => "dem",
+            Solver::Mpm => "mpm",
+        }
+    }
+}
+
+/// The sweep file as written.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepSpec {
+    /// Sweep name.
+    pub name: String,
+    /// One line on what it is for.
+    pub description: String,
+    /// Base scenario per solver, relative to the sweep file.
+    pub solvers: BTreeMap<Solver, PathBuf>,
+    /// Fixed overrides applied to every case (path → value).
+    #[serde(default)]
+    pub set: BTreeMap<String, Value>,
+    /// The varied dimensions (path → values; the lists of one table vary together).
+    pub vary: Vec<BTreeMap<String, Vec<Value>>>,
+}
+
+/// One case: a solver and its resolved scenario.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// Folder name, e.g. `dem_a0.5` or `mpm_a2_friction0.3`.
+    pub name: String,
+    /// The solver.
+    pub solver: Solver,
+    /// The resolved scenario (TOML text, with `name` set to the case name).
+    pub scenario: String,
+    /// The varied values of this case, (path, value) per dimension's first key.
+    pub labels: Vec<(String, Value)>,
+}
+
+/// Reads and expands a sweep file into its cases (in solver, then dimension order).
+pub fn read_sweep(path: &Path) -> Result<(SweepSpec, Vec<Case>)> {
+    let spec: SweepSpec = crate::config::read_toml(path)?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let cases = expand(&spec, dir)?;
+    Ok((spec, cases))
+}
+
+fn err(field: impl Into<String>, reason: impl Into<String>) -> Error {
+    Error::config(field, reason)
+}
+
+/// Splits `key` into (solver it is limited to, path in the scenario).
+fn split(key: &str) -> (Option<Solver>, &str) {
+    for s in [Solver::Dem, Solver::Mpm] {
+        if let Some(rest) = key.strip_prefix(s.name()).and_then(|r| r.strip_prefix('.')) {
+            return (Some(s), rest);
+        }
+    }
+    (None, key)
+}
+
+/// Sets the existing field at dotted `path` of `table` to `value` (same kind of scalar).
+fn set_field(
+    table: &mut toml::Table,
+    path: &str,
+    value: &Value,
+) -> std::result::Result<(), String> {
+    let mut parts = path.split('.').peekable();
+    let mut t = table;
+    while let Some(part) = parts.next() {
+        let Some(slot) = t.get_mut(part) else {
+            return Err(format!("the base scenario has no field `{part}` here"));
+        };
+        if parts.peek().is_none() {
+            let same = matches!(
+                (&*slot, value),
+                (
+                    Value::Float(_) | Value::Integer(_),
+                    Value::Float(_) | Value::Integer(_)
+                ) | (Value::String(_), Value::String(_))
+                    | (Value::Boolean(_), Value::Boolean(_))
+            );
+            if !same {
+                return Err(format!(
+                    "cannot put {} where the base has {}",
+                    value.type_str(),
+                    slot.type_str()
+                ));
+            }
+            *slot = value.clone();
+            return Ok(());
+        }
+        t = match slot {
+            Value::Table(inner) => inner,
+            other => return Err(format!("`{part}` is a {}, not a table", other.type_str())),
+        };
+    }
+    Err("empty path".into())
+}
+
+/// Short form of a path for case names: its last segment, `a` for `aspect_ratio`.
+fn short(path: &str) -> &str {
+    match path.rsplit('.').next().unwrap_or(path) {
+        "aspect_ratio" => "a",
+        s => s,
+    }
+}
+
+fn show(v: &Value) -> String {
+    match v {
+        Value::String(s) => s.clone(),
+        Value::Float(f) => format!("{f}"),
+        other => other.to_string(),
+    }
+}
+
+/// Expands `spec` into its cases; base paths are relative to `dir`.
+pub fn expand(spec: &SweepSpec, dir: &Path) -> Result<Vec<Case>> {
+    if spec.solvers.is_empty() {
+        return Err(err("solvers", "name at least one base scenario (dem, mpm)"));
+    }
+    if spec.vary.is_empty() {
+        return Err(err("vary", "give at least one [[vary]] table"));
+    }
+    for (d, dim) in spec.vary.iter().enumerate() {
+        let mut lens = dim.values().map(Vec::len);
+        let n = lens.next().unwrap_or(0);
+        if n == 0 || lens.any(|m| m != n) {
+            return Err(err(
+                format!("vary[{d}]"),
+                "needs at least one path, each with the same (non-zero) number of values",
+            ));
+        }
+    }
+    let mut cases = Vec::new();
+    for (&solver, base) in &spec.solvers {
+        let base_path = dir.join(base);
+        let text = std::fs::read_to_string(&base_path).map_err(|e| Error::io(&base_path, e))?;
+        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+            err(format!("solvers.{}", solver.name()), e.to_string())
+        })?;
+        let mine = |key: &str| match split(key) {
+            (Some(s), p) if s == solver => Some(p.to_owned()),
+            (Some(_), _) => None,
+            (None, p) => Some(p.to_owned()),
+        };
+        let mut fixed = table;
+        for (key, value) in &spec.set {
+            if let Some(p) = mine(key) {
+                set_field(&mut fixed, &p, value).map_err(|r| {
+                    err(
+                        format!("set.\"{key}\""),
+                        format!("{r} ({})", base.display()),
+                    )
+                })?;
+            }
+        }
+        // Dimensions that concern this solver, as (keys, number of values).
+        let dims: Vec<&BTreeMap<String, Vec<Value>>> = spec
+            .vary
+            .iter()
+            .filter(|dim| dim.keys().any(|k| mine(k).is_some()))
+            .collect();
+        let total: usize = dims
+            .iter()
+            .map(|d| d.values().next().map_or(1, Vec::len))
+            .product();
+        for index in 0..total {
+            let mut t = fixed.clone();
+            let (mut rest, mut name, mut labels) = (index, solver.name().to_owned(), Vec::new());
+            for dim in &dims {
+                let n = dim.values().next().map_or(1, Vec::len);
+                let k = rest % n;
+                rest /= n;
+                let mut first = true;
+                for (key, values) in dim.iter() {
+                    let Some(p) = mine(key) else { continue };
+                    set_field(&mut t, &p, &values[k]).map_err(|r| {
+                        err(
+                            format!("vary.\"{key}\""),
+                            format!("{r} ({})", base.display()),
+                        )
+                    })?;
+                    if first {
+                        name.push_str(&format!("_{}{}", short(&p), show(&values[k])));
+                        labels.push((p.clone(), values[k].clone()));
+                        first = false;
+                    }
+                }
+            }
+            t.insert("name".into(), Value::String(name.clone()));
+            cases.push(Case {
+                name,
+                solver,
+                scenario: toml::to_string(&t).map_err(|e| Error::Other(e.to_string()))?,
+                labels,
+            });
+        }
+    }
+    let mut names: Vec<&str> = cases.iter().map(|c| c.name.as_str()).collect();
+    names.sort_unstable();
+    if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
+        return Err(err(
+            "vary",
+            format!("two cases would share the name `{}`", w[0]),
+        ));
+    }
+    Ok(cases)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec(text: &str) -> SweepSpec {
+        toml::from_str(text).unwrap()
+    }
+
+    fn write(dir: &Path, name: &str, text: &str) {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+
+    #[test]
+    fn expands_zipped_and_crossed_dimensions_per_solver() {
+        let dir = tempfile::tempdir().unwrap();
+        write(dir.path(), "d.toml", "name = \"d\"\n[column]\naspect_ratio = 2\nwidth = 0.1\n[grain_contact]\nfriction = 0.5\n");
+        write(
+            dir.path(),
+            "m.toml",
+            "name = \"m\"\n[column]\naspect_ratio = 2\nwidth = 0.1\n",
+        );
+        let s = spec(
+            r#"
+            name = "s"
+            description = "x"
+            [solvers]
+            dem = "d.toml"
+            mpm = "m.toml"
+            [set]
+            "column.width" = 0.2
+            [[vary]]
+            "column.aspect_ratio" = [0.5, 4]
+            "mpm.column.width" = [0.3, 0.4]
+            [[vary]]
+            "dem.grain_contact.friction" = [0.1, 0.2, 0.3]
+            "#,
+        );
+        let cases = expand(&s, dir.path()).unwrap();
+        let names: Vec<&str> = cases.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "dem_a0.5_friction0.1",
+                "dem_a4_friction0.1",
+                "dem_a0.5_friction0.2",
+                "dem_a4_friction0.2",
+                "dem_a0.5_friction0.3",
+                "dem_a4_friction0.3",
+                "mpm_a0.5",
+                "mpm_a4"
+            ]
+        );
+        let t: toml::Table = cases[3].scenario.parse().unwrap();
+        assert_eq!(t["name"].as_str(), Some("dem_a4_friction0.2"));
+        assert_eq!(t["column"]["aspect_ratio"].as_integer(), Some(4));
+        assert_eq!(t["column"]["width"].as_float(), Some(0.2));
+        assert_eq!(t["grain_contact"]["friction"].as_float(), Some(0.2));
+        let m: toml::Table = cases[7].scenario.parse().unwrap();
+        assert_eq!(m["column"]["width"].as_float(), Some(0.4));
+    }
+
+    #[test]
+    fn refuses_unknown_paths_mismatched_kinds_and_ragged_lists() {
+        let dir = tempfile::tempdir().unwrap();
+        write(
+            dir.path(),
+            "d.toml",
+            "name = \"d\"\n[column]\naspect_ratio = 2\n",
+        );
+        let base = "name = \"s\"\ndescription = \"x\"\n[solvers]\ndem = \"d.toml\"\n";
+        let msg = |extra: &str| {
+            expand(&spec(&format!("{base}{extra}")), dir.path())
+                .unwrap_err()
+                .to_string()
+        };
+        let m = msg("[[vary]]\n\"column.aspectratio\" = [1.0]\n");
+        assert!(
+            m.contains("column.aspectratio") && m.contains("no field"),
+            "{m}"
+        );
+        let m = msg("[[vary]]\n\"column.aspect_ratio\" = [\"tall\"]\n");
+        assert!(m.contains("cannot put string"), "{m}");
+        let m = msg("[[vary]]\n\"column.aspect_ratio\" = [1.0, 2.0]\n\"name\" = [\"x\"]\n");
+        assert!(m.contains("vary[0]"), "{m}");
+        let bad: std::result::Result<SweepSpec, _> = toml::from_str(&format!(
+            "{base}typo = 1\n[[vary]]\n\"column.aspect_ratio\" = [1.0]\n"
+        ));
+        assert!(bad.is_err());
+    }
+}

@@ -27,6 +27,17 @@
 //! local damping work α|f|·|v|Δt. What is left, E_total(t) − E_total(0), is the scheme's own
 //! numerical dissipation (the FLIP/PIC transfers), reported as the budget error.
 //!
+//! Traction (pressure) loads on boundary faces of points ([`Traction`]): the force
+//! f = −p L₀ cof(F) N (Nanson: cof F = J F⁻ᵀ; N the face's outward unit normal in the reference
+//! configuration, ±x or ±y; L₀ = 2 l_p the face's reference length) is added to the nodal
+//! forces as the exact integral of the nodal functions over the face,
+//! f_i = f · N_i(x_p + l_p N) along the normal (the hat at the face line) × S_i(y_p) along the
+//! face (the uGIMP weight of a segment of length 2 l_p, = (1/2l_p)∫ N_i dy over the face). The
+//! load is the same for both shape kinds; with uGIMP it is the exact boundary term of the
+//! internal force, Σ_p V_p ∇S_ip = ∮ N_i n dΓ, so a uniformly stressed body held by its
+//! boundary tractions is in exact discrete equilibrium wherever its edges lie. Applied serially
+//! (boundary points only). Their work f·(v^n + v^{n+1})/2 Δt is booked (`MpmEnergy::traction`).
+//!
 //! Time step: Δt ≤ C h/c with c = √((K + 4G/3)/ρ) the P-wave speed and C the Courant number;
 //! a larger step is refused (Error::Config on `time.dt`).
 //!
@@ -97,6 +108,8 @@ pub struct MpmEnergy {
     pub boundary_friction: f64,
     /// Work of the local damping forces.
     pub damping: f64,
+    /// Work done on the material by the traction loads (an input, not a dissipation).
+    pub traction: f64,
 }
 
 impl MpmEnergy {
@@ -108,10 +121,22 @@ impl MpmEnergy {
     pub fn dissipated(&self) -> f64 {
         self.plastic + self.boundary_normal + self.boundary_friction + self.damping
     }
-    /// Mechanical + dissipated (constant up to the scheme's own numerical dissipation).
+    /// Mechanical + dissipated − traction work (constant up to the scheme's own numerical
+    /// dissipation).
     pub fn total(&self) -> f64 {
-        self.mechanical() + self.dissipated()
+        self.mechanical() + self.dissipated() - self.traction
     }
+}
+
+/// A pressure load on one boundary face of a point's domain (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Traction {
+    /// Index of the point (kept valid when the points are re-sorted).
+    pub point: u32,
+    /// Outward unit normal of the face in the reference configuration: ±x or ±y.
+    pub normal: [f64; 2],
+    /// Pressure on the face (Pa, compression positive).
+    pub pressure: f64,
 }
 
 /// Columns per stripe of the parallel P2G.
@@ -143,6 +168,9 @@ pub struct Mpm {
     /// Each point's stencil at the start of the step (computed once in `bin`, used by every
     /// pass of the step: the positions move only at the end of the last pass).
     stencils: Vec<Stencil>,
+    tractions: Vec<Traction>,
+    traction_work: f64,
+    inverse: Vec<u32>,
 }
 
 /// Stencil of a point: first node (i, j) and 1-D weights and derivatives.
@@ -260,6 +288,9 @@ impl Mpm {
             scratch: PermuteScratch::default(),
             mass_eps,
             stencils: vec![Stencil::default(); n],
+            tractions: Vec::new(),
+            traction_work: 0.0,
+            inverse: Vec::new(),
         };
         // The stress work starts at the initial elastic energy (so plastic = work − elastic).
         for p in 0..n {
@@ -293,6 +324,104 @@ impl Mpm {
         }
     }
 
+    /// Add pressure loads on boundary faces of points. Refuses a point index out of range, a
+    /// normal that is not ±x or ±y, a pressure that is not finite, or a face outside the grid.
+    pub fn add_tractions(&mut self, loads: impl IntoIterator<Item = Traction>) -> Result<()> {
+        for t in loads {
+            if t.point as usize >= self.points.len() {
+                return Err(Error::Other(format!(
+                    "traction on point {} of {}",
+                    t.point,
+                    self.points.len()
+                )));
+            }
+            let axis_aligned = matches!(
+                t.normal,
+                [1.0, 0.0] | [-1.0, 0.0] | [0.0, 1.0] | [0.0, -1.0]
+            );
+            if !axis_aligned || !t.pressure.is_finite() {
+                return Err(Error::Other(format!(
+                    "traction normal must be ±x or ±y and the pressure finite, got {:?}, {}",
+                    t.normal, t.pressure
+                )));
+            }
+            self.tractions.push(t);
+        }
+        self.bin()
+    }
+
+    /// The traction loads (point indices as the points are ordered now).
+    pub fn tractions(&self) -> &[Traction] {
+        &self.tractions
+    }
+
+    /// Force of a traction load and its face's node stencil (first node and 1-D weights).
+    #[inline]
+    fn traction_force(&self, t: &Traction) -> ([f64; 2], Stencil) {
+        let q = t.point as usize;
+        let g = &self.grid;
+        let (x, lp, f) = (
+            self.points.pos[q],
+            self.points.half_size[q],
+            self.points.def_grad[q],
+        );
+        // cof F = J F⁻ᵀ = [[F_yy, −F_yx], [−F_xy, F_xx]] with F = (xx, xy, yx, yy).
+        let n = t.normal;
+        let cn = [f[3] * n[0] - f[2] * n[1], -f[1] * n[0] + f[0] * n[1]];
+        let scale = -t.pressure * 2.0 * lp;
+        let force = [scale * cn[0], scale * cn[1]];
+        // Face line along the normal: hat weights; along the face: uGIMP weights.
+        let hat = |c: f64| -> (i64, [f64; 3]) {
+            let r = c / g.h;
+            let i = r.floor();
+            (i as i64, [1.0 - (r - i), r - i, 0.0])
+        };
+        let local = [x[0] - g.origin[0], x[1] - g.origin[1]];
+        let mut st = Stencil::default();
+        if n[0] != 0.0 {
+            (st.i0, st.wx) = hat(local[0] + n[0] * lp);
+            (st.j0, st.wy, _) = weights_1d(ShapeKind::Gimp, local[1], g.h, lp);
+        } else {
+            (st.i0, st.wx, _) = weights_1d(ShapeKind::Gimp, local[0], g.h, lp);
+            (st.j0, st.wy) = hat(local[1] + n[1] * lp);
+        }
+        (force, st)
+    }
+
+    /// Add the traction forces to the nodal forces (after a force P2G).
+    fn scatter_tractions(&mut self) {
+        let nny = self.grid.ny + 1;
+        for k in 0..self.tractions.len() {
+            let (f, st) = self.traction_force(&self.tractions[k]);
+            for a in 0..3 {
+                for b in 0..3 {
+                    let w = st.wx[a] * st.wy[b];
+                    let node = (st.i0 as usize + a) * nny + st.j0 as usize + b;
+                    self.grid.sums[node][3] += w * f[0];
+                    self.grid.sums[node][4] += w * f[1];
+                }
+            }
+        }
+    }
+
+    /// Book the work of the traction forces over the step, f · Σ w (v^n + v^{n+1})/2 Δt.
+    fn book_traction_work(&mut self) {
+        let nny = self.grid.ny + 1;
+        let mut work = 0.0;
+        for t in &self.tractions {
+            let (f, st) = self.traction_force(t);
+            for a in 0..3 {
+                for b in 0..3 {
+                    let w = st.wx[a] * st.wy[b];
+                    let node = (st.i0 as usize + a) * nny + st.j0 as usize + b;
+                    let (v0, v1) = (self.grid.vel[node], self.grid.vel_new[node]);
+                    work += w * (f[0] * (v0[0] + v1[0]) + f[1] * (v0[1] + v1[1]));
+                }
+            }
+        }
+        self.traction_work += 0.5 * self.dt * work;
+    }
+
     /// Re-sort the points into cell order (x-major, as the nodes).
     fn resort(&mut self) {
         let g = &self.grid;
@@ -322,6 +451,16 @@ impl Mpm {
         }
         let perm = std::mem::take(&mut self.perm);
         self.points.permute(&perm, &mut self.scratch);
+        if !self.tractions.is_empty() {
+            // Old index perm[k] is now k.
+            self.inverse.resize(perm.len(), 0);
+            for (k, &old) in perm.iter().enumerate() {
+                self.inverse[old as usize] = k as u32;
+            }
+            for t in &mut self.tractions {
+                t.point = self.inverse[t.point as usize];
+            }
+        }
         self.perm = perm;
     }
 
@@ -367,6 +506,18 @@ impl Mpm {
         }
         for s in 0..ns {
             self.stripe_start[s + 1] += self.stripe_start[s];
+        }
+        for t in &self.tractions {
+            let (_, st) = self.traction_force(t);
+            if st.i0 < 0 || st.j0 < 0 || st.i0 + 2 > g.nx as i64 || st.j0 + 2 > g.ny as i64 {
+                return Err(Error::Unstable {
+                    step: self.steps,
+                    time: self.time,
+                    x: st.i0.max(0) as usize,
+                    y: st.j0.max(0) as usize,
+                    reason: format!("the traction face of point {} left the grid", t.point),
+                });
+            }
         }
         // Stable scatter: within a stripe the points keep their (cell) order.
         let mut fill = std::mem::take(&mut self.perm);
@@ -653,20 +804,26 @@ impl Mpm {
                 self.grid_velocity(true);
                 self.point_pass(PointPass::StressFromMap)?;
                 self.p2g(false, true, false);
+                self.scatter_tractions();
                 self.grid_velocity(false);
                 self.grid_update();
+                self.book_traction_work();
                 self.point_pass(PointPass::VelocityAndMove)?;
             }
             Scheme::Usl => {
                 self.p2g(true, true, false);
+                self.scatter_tractions();
                 self.grid_velocity(false);
                 self.grid_update();
+                self.book_traction_work();
                 self.point_pass(PointPass::All)?;
             }
             Scheme::Musl => {
                 self.p2g(true, true, false);
+                self.scatter_tractions();
                 self.grid_velocity(false);
                 self.grid_update();
+                self.book_traction_work();
                 self.point_pass(PointPass::Velocity)?;
                 self.p2g(false, false, true);
                 self.grid_velocity(true);
@@ -726,6 +883,7 @@ impl Mpm {
             boundary_normal: self.booked[0],
             boundary_friction: self.booked[1],
             damping: self.booked[2],
+            traction: self.traction_work,
         }
     }
 

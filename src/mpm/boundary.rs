@@ -160,4 +160,19 @@ mod tests {
         r.apply(&mut v);
         assert_eq!(v, [0.0, -0.4]);
     }
+
+    /// A platen sets the normal velocity (into the material) and leaves the tangential one;
+    /// the reported normal change is what it imposed.
+    #[test]
+    fn platen_prescribes_the_normal_velocity() {
+        let w = Wall {
+            side: Side::Top,
+            position: 1.0,
+            kind: WallKind::Platen { speed: 0.01 },
+        };
+        let mut v = [0.2, 0.5];
+        let (dn, dt) = w.apply(&mut v);
+        assert_eq!(v, [0.2, -0.01]);
+        assert_eq!((dn, dt), ([0.0, -0.51], [0.0; 2]));
+    }
 }

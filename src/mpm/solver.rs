@@ -17,6 +17,14 @@
 //! * v_i^{n+1} = v_i + Δt f_i/m_i, then the walls ([`super::boundary`]);
 //! * FLIP velocity v_p ← v_p + Σ_i N_ip (v_i^{n+1} − v_i) (optionally blended with PIC,
 //!   [`MpmParams::pic_fraction`]), position x_p ← x_p + Δt Σ_i N_ip v_i^{n+1};
+//! * or, with [`Transfer::Apic`] (affine PIC, Jiang et al. 2015): P2G momentum
+//!   p_i = Σ_p N_ip m_p (v_p + B_p D_p⁻¹ (x_i − x_p)), G2P v_p = Σ_i N_ip v_i^{n+1},
+//!   B_p = Σ_i N_ip v_i^{n+1} ⊗ (x_i − x_p), with D_p = Σ_i N_ip (x_i − x_p) ⊗ (x_i − x_p)
+//!   (diagonal for tensor-product weights). D_p depends on the point's place in its cell for
+//!   uGIMP (it is h²/4 I only for quadratic B-splines), so B_p is stored and D_p⁻¹ taken at the
+//!   position of each P2G: then the angular momentum Σ_p m_p (x_p × v_p + B_p,yx − B_p,xy)
+//!   equals the grid's Σ_i m_i x_i × v_i after P2G and after G2P, and is conserved to
+//!   round-off without external torques. uGIMP only (for the hat, D_p = 0 on a node line);
 //! * velocity gradient L = Σ_i v_i ⊗ ∇N_ip, Δε = Δt sym L, spin Δω = Δt ½(L_xy − L_yx),
 //!   F ← (I + Δt L) F, V = det F · V₀, σ ← material(σ, Δε, Δω).
 //!
@@ -128,6 +136,16 @@ impl MpmEnergy {
     }
 }
 
+/// Velocity transfer between points and grid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Transfer {
+    /// FLIP, blended with PIC by [`MpmParams::pic_fraction`].
+    Flip,
+    /// Affine particle-in-cell (no tuning parameter; see the module doc).
+    Apic,
+}
+
 /// A pressure load on one boundary face of a point's domain (see the module doc).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Traction {
@@ -170,6 +188,7 @@ pub struct Mpm {
     stencils: Vec<Stencil>,
     tractions: Vec<Traction>,
     traction_work: f64,
+    transfer: Transfer,
     /// Force and point position of each traction as applied this step.
     traction_applied: Vec<([f64; 2], [f64; 2])>,
     inverse: Vec<u32>,
@@ -292,6 +311,7 @@ impl Mpm {
             stencils: vec![Stencil::default(); n],
             tractions: Vec::new(),
             traction_work: 0.0,
+            transfer: Transfer::Flip,
             traction_applied: Vec::new(),
             inverse: Vec::new(),
         };
@@ -303,6 +323,47 @@ impl Mpm {
         mpm.resort();
         mpm.bin()?;
         Ok(mpm)
+    }
+
+    /// Choose the velocity transfer. APIC is refused with standard MPM shape functions (D_p is
+    /// singular on node lines) or a PIC fraction > 0 (APIC has none), naming the field.
+    pub fn set_transfer(&mut self, transfer: Transfer) -> Result<()> {
+        if transfer == Transfer::Apic {
+            if self.params.shape != ShapeKind::Gimp {
+                return Err(Error::config(
+                    "mpm.transfer",
+                    "APIC needs uGIMP shape functions (with the hat D_p = 0 on node lines)",
+                ));
+            }
+            if self.params.pic_fraction != 0.0 {
+                return Err(Error::config(
+                    "mpm.pic_fraction",
+                    "must be 0 with the APIC transfer",
+                ));
+            }
+        }
+        self.transfer = transfer;
+        for b in self.points.affine.iter_mut() {
+            *b = [0.0; 4];
+        }
+        Ok(())
+    }
+
+    /// The velocity transfer in use.
+    pub fn transfer(&self) -> Transfer {
+        self.transfer
+    }
+
+    /// Total angular momentum about the origin (per m), Σ_p m_p (x_p × v_p + B_p,yx − B_p,xy)
+    /// (the affine term is zero with FLIP/PIC).
+    pub fn angular_momentum(&self) -> f64 {
+        let p = &self.points;
+        (0..p.len())
+            .map(|q| {
+                let (x, v, b) = (p.pos[q], p.vel[q], p.affine[q]);
+                p.mass[q] * (x[0] * v[1] - x[1] * v[0] + b[2] - b[1])
+            })
+            .sum()
     }
 
     /// The time step in use (s).
@@ -558,6 +619,8 @@ impl Mpm {
         let (order, starts) = (&self.order, &self.stripe_start);
         let stencils = &self.stencils;
         let ns = starts.len() - 1;
+        let apic = self.transfer == Transfer::Apic && (mass || momentum);
+        let (origin, h) = (g.origin, g.h);
         g.sums.par_iter_mut().for_each(|s| {
             if mass {
                 s[0] = 0.0;
@@ -590,6 +653,20 @@ impl Mpm {
                         let v = pts.vel[q];
                         let vol = pts.vol[q];
                         let sg = pts.stress[q];
+                        // APIC: C = B D⁻¹ with D = diag(Σ w_x d_x², Σ w_y d_y²) here.
+                        let (mut c, mut dx, mut dy) = ([0.0; 4], [0.0; 3], [0.0; 3]);
+                        if apic {
+                            let x = pts.pos[q];
+                            let (mut ddx, mut ddy) = (0.0, 0.0);
+                            for k in 0..3 {
+                                dx[k] = origin[0] + (st.i0 + k as i64) as f64 * h - x[0];
+                                dy[k] = origin[1] + (st.j0 + k as i64) as f64 * h - x[1];
+                                ddx += st.wx[k] * dx[k] * dx[k];
+                                ddy += st.wy[k] * dy[k] * dy[k];
+                            }
+                            let bm = pts.affine[q];
+                            c = [bm[0] / ddx, bm[1] / ddy, bm[2] / ddx, bm[3] / ddy];
+                        }
                         for a in 0..3 {
                             let base = (st.i0 + a as i64 - col0) as usize * nny + st.j0 as usize;
                             for b in 0..3 {
@@ -598,7 +675,14 @@ impl Mpm {
                                 if mass {
                                     node[0] += w * m;
                                 }
-                                if mass || momentum {
+                                if apic {
+                                    let u = [
+                                        v[0] + c[0] * dx[a] + c[1] * dy[b],
+                                        v[1] + c[2] * dx[a] + c[3] * dy[b],
+                                    ];
+                                    node[1] += w * m * u[0];
+                                    node[2] += w * m * u[1];
+                                } else if mass || momentum {
                                     node[1] += w * m * v[0];
                                     node[2] += w * m * v[1];
                                 }
@@ -689,6 +773,7 @@ impl Mpm {
         };
         let dt = self.dt;
         let pic = self.params.pic_fraction;
+        let apic = self.transfer == Transfer::Apic;
         let mat = &self.material;
         let do_v = matches!(
             pass,
@@ -714,82 +799,100 @@ impl Mpm {
             p.work.par_chunks_mut(CHUNK),
             p.vol0.par_chunks(CHUNK),
             stencils.par_chunks(CHUNK),
+            p.affine.par_chunks_mut(CHUNK),
         )
             .into_par_iter()
             .enumerate()
-            .map(|(k, (pos, vel, fg, vol, sig, state, work, vol0, sts))| {
-                let mut bad = None;
-                for q in 0..pos.len() {
-                    let st = &sts[q];
-                    let mut dv = [0.0; 2];
-                    let mut xn = [0.0; 2];
-                    let mut l = [0.0; 4];
-                    for a in 0..3 {
-                        let base = (st.i0 + a as i64) as usize * nny + st.j0 as usize;
-                        for b in 0..3 {
-                            let n = base + b;
-                            let w = st.wx[a] * st.wy[b];
-                            if do_v {
-                                dv[0] += w * (vnew[n][0] - vold[n][0]);
-                                dv[1] += w * (vnew[n][1] - vold[n][1]);
-                            }
-                            if do_x || pic > 0.0 {
-                                xn[0] += w * vnew[n][0];
-                                xn[1] += w * vnew[n][1];
-                            }
-                            if do_s {
-                                let gx = st.gx[a] * st.wy[b];
-                                let gy = st.wx[a] * st.gy[b];
-                                let v = vstrain[n];
-                                l[0] += v[0] * gx;
-                                l[1] += v[0] * gy;
-                                l[2] += v[1] * gx;
-                                l[3] += v[1] * gy;
+            .map(
+                |(k, (pos, vel, fg, vol, sig, state, work, vol0, sts, aff))| {
+                    let mut bad = None;
+                    for q in 0..pos.len() {
+                        let st = &sts[q];
+                        let mut dv = [0.0; 2];
+                        let mut xn = [0.0; 2];
+                        let mut l = [0.0; 4];
+                        let mut bm = [0.0; 4];
+                        for a in 0..3 {
+                            let base = (st.i0 + a as i64) as usize * nny + st.j0 as usize;
+                            for b in 0..3 {
+                                let n = base + b;
+                                let w = st.wx[a] * st.wy[b];
+                                if do_v {
+                                    dv[0] += w * (vnew[n][0] - vold[n][0]);
+                                    dv[1] += w * (vnew[n][1] - vold[n][1]);
+                                }
+                                if do_x || pic > 0.0 || apic {
+                                    xn[0] += w * vnew[n][0];
+                                    xn[1] += w * vnew[n][1];
+                                }
+                                if apic && do_v {
+                                    let d = [
+                                        origin[0] + (st.i0 + a as i64) as f64 * h - pos[q][0],
+                                        origin[1] + (st.j0 + b as i64) as f64 * h - pos[q][1],
+                                    ];
+                                    let u = vnew[n];
+                                    bm[0] += w * u[0] * d[0];
+                                    bm[1] += w * u[0] * d[1];
+                                    bm[2] += w * u[1] * d[0];
+                                    bm[3] += w * u[1] * d[1];
+                                }
+                                if do_s {
+                                    let gx = st.gx[a] * st.wy[b];
+                                    let gy = st.wx[a] * st.gy[b];
+                                    let v = vstrain[n];
+                                    l[0] += v[0] * gx;
+                                    l[1] += v[0] * gy;
+                                    l[2] += v[1] * gx;
+                                    l[3] += v[1] * gy;
+                                }
                             }
                         }
-                    }
-                    if do_v {
-                        // FLIP increment, blended with the PIC velocity Σ N v^{n+1}.
-                        vel[q][0] = (1.0 - pic) * (vel[q][0] + dv[0]) + pic * xn[0];
-                        vel[q][1] = (1.0 - pic) * (vel[q][1] + dv[1]) + pic * xn[1];
-                    }
-                    if do_s {
-                        let f = fg[q];
-                        let a = [1.0 + dt * l[0], dt * l[1], dt * l[2], 1.0 + dt * l[3]];
-                        let fnew = [
-                            a[0] * f[0] + a[1] * f[2],
-                            a[0] * f[1] + a[1] * f[3],
-                            a[2] * f[0] + a[3] * f[2],
-                            a[2] * f[1] + a[3] * f[3],
-                        ];
-                        let j = fnew[0] * fnew[3] - fnew[1] * fnew[2];
-                        if (j.is_nan() || j <= 0.0) && bad.is_none() {
-                            bad = Some((k * CHUNK + q, format!("det F = {j:e} ≤ 0")));
+                        if do_v && apic {
+                            vel[q] = xn;
+                            aff[q] = bm;
+                        } else if do_v {
+                            // FLIP increment, blended with the PIC velocity Σ N v^{n+1}.
+                            vel[q][0] = (1.0 - pic) * (vel[q][0] + dv[0]) + pic * xn[0];
+                            vel[q][1] = (1.0 - pic) * (vel[q][1] + dv[1]) + pic * xn[1];
                         }
-                        fg[q] = fnew;
-                        let vnew_ = j * vol0[q];
-                        let de = [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])];
-                        let spin = 0.5 * dt * (l[1] - l[2]);
-                        let s0 = sig[q];
-                        let s1 = mat.update_stress(&s0, &de, spin, &mut state[q]);
-                        let smid = [
-                            0.5 * (s0[0] + s1[0]),
-                            0.5 * (s0[1] + s1[1]),
-                            0.5 * (s0[2] + s1[2]),
-                        ];
-                        work[q] += 0.5
-                            * (vol[q] + vnew_)
-                            * (smid[0] * de[0] + smid[1] * de[1] + 2.0 * smid[2] * de[2]);
-                        sig[q] = s1;
-                        vol[q] = vnew_;
+                        if do_s {
+                            let f = fg[q];
+                            let a = [1.0 + dt * l[0], dt * l[1], dt * l[2], 1.0 + dt * l[3]];
+                            let fnew = [
+                                a[0] * f[0] + a[1] * f[2],
+                                a[0] * f[1] + a[1] * f[3],
+                                a[2] * f[0] + a[3] * f[2],
+                                a[2] * f[1] + a[3] * f[3],
+                            ];
+                            let j = fnew[0] * fnew[3] - fnew[1] * fnew[2];
+                            if (j.is_nan() || j <= 0.0) && bad.is_none() {
+                                bad = Some((k * CHUNK + q, format!("det F = {j:e} ≤ 0")));
+                            }
+                            fg[q] = fnew;
+                            let vnew_ = j * vol0[q];
+                            let de = [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])];
+                            let spin = 0.5 * dt * (l[1] - l[2]);
+                            let s0 = sig[q];
+                            let s1 = mat.update_stress(&s0, &de, spin, &mut state[q]);
+                            let smid = [
+                                0.5 * (s0[0] + s1[0]),
+                                0.5 * (s0[1] + s1[1]),
+                                0.5 * (s0[2] + s1[2]),
+                            ];
+                            work[q] += 0.5
+                                * (vol[q] + vnew_)
+                                * (smid[0] * de[0] + smid[1] * de[1] + 2.0 * smid[2] * de[2]);
+                            sig[q] = s1;
+                            vol[q] = vnew_;
+                        }
+                        if do_x {
+                            pos[q][0] += dt * xn[0];
+                            pos[q][1] += dt * xn[1];
+                        }
                     }
-                    if do_x {
-                        pos[q][0] += dt * xn[0];
-                        pos[q][1] += dt * xn[1];
-                    }
-                }
-                bad
-            })
+                    bad
+                },
+            )
             .find_any(|b| b.is_some())
             .flatten();
         if let Some((q, why)) = bad {

@@ -611,6 +611,8 @@ impl Mpm {
 
     /// Scatter point quantities to the nodes. `mass`: mass and momentum; `force`: internal and
     /// gravity force; `momentum`: momentum only (MUSL re-map; mass kept).
+    // The stencil loops index several 3-arrays (weights, gradients, offsets) by node.
+    #[allow(clippy::needless_range_loop)]
     fn p2g(&mut self, mass: bool, force: bool, momentum: bool) {
         let g = &mut self.grid;
         let nny = g.ny + 1;

@@ -197,3 +197,42 @@ fn runout_counts_only_points_attached_to_the_main_mass() {
 fn mpm_friction_sliding_block() {
     case_passes("mpm-friction");
 }
+
+/// APIC is refused with standard MPM shape functions and with a PIC fraction, naming the field.
+#[test]
+fn apic_is_refused_where_it_is_undefined() {
+    use granflow::mpm::*;
+    let make = |shape: ShapeKind, pic: f64| {
+        let mut pts = Points::default();
+        pts.fill_rect([0.1, 0.1], [0.2, 0.2], 0.05, 2, 1000.0);
+        let mat = MaterialModel::Elastic(LinearElastic {
+            density: 1000.0,
+            youngs_modulus: 1e6,
+            poisson_ratio: 0.3,
+        });
+        let params = MpmParams {
+            shape,
+            scheme: Scheme::Musl,
+            gravity: [0.0, 0.0],
+            courant: 0.5,
+            dt: None,
+            damping: 0.0,
+            pic_fraction: pic,
+            resort_every: 20,
+        };
+        Mpm::new(Grid::new(8, 8, 0.05, [0.0; 2], vec![]), pts, mat, params).unwrap()
+    };
+    let e = make(ShapeKind::Standard, 0.0)
+        .set_transfer(Transfer::Apic)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("mpm.transfer"), "{e}");
+    let e = make(ShapeKind::Gimp, 0.05)
+        .set_transfer(Transfer::Apic)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("mpm.pic_fraction"), "{e}");
+    assert!(make(ShapeKind::Gimp, 0.0)
+        .set_transfer(Transfer::Apic)
+        .is_ok());
+}

@@ -11,6 +11,11 @@
 //!   Δv_n = −v_n, and the tangential speed is reduced by at most μ Δv_n:
 //!   v_t ← v_t · max(0, 1 − μ Δv_n/|v_t|) (the impulse m Δv_t is bounded by μ m Δv_n);
 //!   separating nodes (v_n ≥ 0) are free.
+//! * `Platen { speed }`: a smooth rigid platen moving along its inward normal at `speed`
+//!   (m/s, positive into the material): v_n = speed, v_t free (a moving roller, used for
+//!   displacement-controlled loading in `mpm-mc-biaxial`). Its nodes stay on the wall's grid
+//!   line while the material moves, so it is meant for small platen travel (≪ h · cells).
+//!   Not a scenario option (not deserialised).
 //!
 //! Each constraint returns the velocity change it made, split into its normal and tangential
 //! parts, so the solver can book the work of the constraint impulse (see
@@ -31,6 +36,12 @@ pub enum WallKind {
     Friction {
         /// Coulomb friction coefficient μ between wall and material.
         mu: f64,
+    },
+    /// Smooth rigid platen moving along the inward normal at `speed` (m/s).
+    #[serde(skip)]
+    Platen {
+        /// Normal velocity into the material (m/s).
+        speed: f64,
     },
 }
 
@@ -96,6 +107,10 @@ impl Wall {
                 *v = vt;
                 (dn, [0.0; 2])
             }
+            WallKind::Platen { speed } => {
+                *v = [vt[0] + speed * n[0], vt[1] + speed * n[1]];
+                ([dn[0] + speed * n[0], dn[1] + speed * n[1]], [0.0; 2])
+            }
             WallKind::Friction { mu } => {
                 if vn >= 0.0 {
                     return ([0.0; 2], [0.0; 2]);
@@ -144,5 +159,20 @@ mod tests {
         let mut v = [0.3, -0.4];
         r.apply(&mut v);
         assert_eq!(v, [0.0, -0.4]);
+    }
+
+    /// A platen sets the normal velocity (into the material) and leaves the tangential one;
+    /// the reported normal change is what it imposed.
+    #[test]
+    fn platen_prescribes_the_normal_velocity() {
+        let w = Wall {
+            side: Side::Top,
+            position: 1.0,
+            kind: WallKind::Platen { speed: 0.01 },
+        };
+        let mut v = [0.2, 0.5];
+        let (dn, dt) = w.apply(&mut v);
+        assert_eq!(v, [0.2, -0.01]);
+        assert_eq!((dn, dt), ([0.0, -0.51], [0.0; 2]));
     }
 }

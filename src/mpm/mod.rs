@@ -31,4 +31,4 @@ pub use grid::Grid;
 pub use material::{LinearElastic, Material, MaterialModel, MaterialState, MohrCoulomb};
 pub use points::Points;
 pub use shape::ShapeKind;
-pub use solver::{cfl_step, Mpm, MpmEnergy, MpmParams, Scheme};
+pub use solver::{cfl_step, Mpm, MpmEnergy, MpmParams, Scheme, Traction, Transfer};

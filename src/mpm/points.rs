@@ -28,6 +28,9 @@ pub struct Points {
     pub half_size: Vec<f64>,
     /// Stress work done on the point, ∫ σ : D V dt (J per m), plus its initial elastic energy.
     pub work: Vec<f64>,
+    /// APIC affine matrix B_p = Σ_i N_ip v_i ⊗ (x_i − x_p) (xx, xy, yx, yy), m²/s; zero and
+    /// unused with the FLIP/PIC transfer.
+    pub affine: Vec<[f64; 4]>,
 }
 
 impl Points {
@@ -53,6 +56,7 @@ impl Points {
         self.state.push(MaterialState::default());
         self.half_size.push(half_size);
         self.work.push(0.0);
+        self.affine.push([0.0; 4]);
     }
 
     /// Fill the rectangle [x0, x1] × [y0, y1] with `n` × `n` points per cell of size `h` (the
@@ -87,6 +91,7 @@ impl Points {
         apply(&mut self.work, perm, &mut scratch.s);
         apply(&mut self.def_grad, perm, &mut scratch.v4);
         apply(&mut self.stress, perm, &mut scratch.v4);
+        apply(&mut self.affine, perm, &mut scratch.v4);
         apply(&mut self.state, perm, &mut scratch.st);
     }
 }

@@ -17,6 +17,14 @@
 //! * v_i^{n+1} = v_i + Δt f_i/m_i, then the walls ([`super::boundary`]);
 //! * FLIP velocity v_p ← v_p + Σ_i N_ip (v_i^{n+1} − v_i) (optionally blended with PIC,
 //!   [`MpmParams::pic_fraction`]), position x_p ← x_p + Δt Σ_i N_ip v_i^{n+1};
+//! * or, with [`Transfer::Apic`] (affine PIC, Jiang et al. 2015): P2G momentum
+//!   p_i = Σ_p N_ip m_p (v_p + B_p D_p⁻¹ (x_i − x_p)), G2P v_p = Σ_i N_ip v_i^{n+1},
+//!   B_p = Σ_i N_ip v_i^{n+1} ⊗ (x_i − x_p), with D_p = Σ_i N_ip (x_i − x_p) ⊗ (x_i − x_p)
+//!   (diagonal for tensor-product weights). D_p depends on the point's place in its cell for
+//!   uGIMP (it is h²/4 I only for quadratic B-splines), so B_p is stored and D_p⁻¹ taken at the
+//!   position of each P2G: then the angular momentum Σ_p m_p (x_p × v_p + B_p,yx − B_p,xy)
+//!   equals the grid's Σ_i m_i x_i × v_i after P2G and after G2P, and is conserved to
+//!   round-off without external torques. uGIMP only (for the hat, D_p = 0 on a node line);
 //! * velocity gradient L = Σ_i v_i ⊗ ∇N_ip, Δε = Δt sym L, spin Δω = Δt ½(L_xy − L_yx),
 //!   F ← (I + Δt L) F, V = det F · V₀, σ ← material(σ, Δε, Δω).
 //!
@@ -26,6 +34,17 @@
 //! and step (normal part: impact; tangential part: friction; zero for a node held at rest);
 //! local damping work α|f|·|v|Δt. What is left, E_total(t) − E_total(0), is the scheme's own
 //! numerical dissipation (the FLIP/PIC transfers), reported as the budget error.
+//!
+//! Traction (pressure) loads on boundary faces of points ([`Traction`]): the force
+//! f = −p L₀ cof(F) N (Nanson: cof F = J F⁻ᵀ; N the face's outward unit normal in the reference
+//! configuration, ±x or ±y; L₀ = 2 l_p the face's reference length) is added to the nodal
+//! forces as the exact integral of the nodal functions over the face,
+//! f_i = f · N_i(x_p + l_p N) along the normal (the hat at the face line) × S_i(y_p) along the
+//! face (the uGIMP weight of a segment of length 2 l_p, = (1/2l_p)∫ N_i dy over the face). The
+//! load is the same for both shape kinds; with uGIMP it is the exact boundary term of the
+//! internal force, Σ_p V_p ∇S_ip = ∮ N_i n dΓ, so a uniformly stressed body held by its
+//! boundary tractions is in exact discrete equilibrium wherever its edges lie. Applied serially
+//! (boundary points only). Their work f·Δx_face is booked (`MpmEnergy::traction`).
 //!
 //! Time step: Δt ≤ C h/c with c = √((K + 4G/3)/ρ) the P-wave speed and C the Courant number;
 //! a larger step is refused (Error::Config on `time.dt`).
@@ -97,6 +116,8 @@ pub struct MpmEnergy {
     pub boundary_friction: f64,
     /// Work of the local damping forces.
     pub damping: f64,
+    /// Work done on the material by the traction loads (an input, not a dissipation).
+    pub traction: f64,
 }
 
 impl MpmEnergy {
@@ -108,9 +129,10 @@ impl MpmEnergy {
     pub fn dissipated(&self) -> f64 {
         self.plastic + self.boundary_normal + self.boundary_friction + self.damping
     }
-    /// Mechanical + dissipated (constant up to the scheme's own numerical dissipation).
+    /// Mechanical + dissipated − traction work (constant up to the scheme's own numerical
+    /// dissipation).
     pub fn total(&self) -> f64 {
-        self.mechanical() + self.dissipated()
+        self.mechanical() + self.dissipated() - self.traction
     }
 
     /// Where the potential energy released since `start` went (collision = inelastic wall
@@ -127,6 +149,27 @@ impl MpmEnergy {
             damping: self.damping - start.damping,
         }
     }
+}
+
+/// Velocity transfer between points and grid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Transfer {
+    /// FLIP, blended with PIC by [`MpmParams::pic_fraction`].
+    Flip,
+    /// Affine particle-in-cell (no tuning parameter; see the module doc).
+    Apic,
+}
+
+/// A pressure load on one boundary face of a point's domain (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Traction {
+    /// Index of the point (kept valid when the points are re-sorted).
+    pub point: u32,
+    /// Outward unit normal of the face in the reference configuration: ±x or ±y.
+    pub normal: [f64; 2],
+    /// Pressure on the face (Pa, compression positive).
+    pub pressure: f64,
 }
 
 /// Columns per stripe of the parallel P2G.
@@ -158,6 +201,12 @@ pub struct Mpm {
     /// Each point's stencil at the start of the step (computed once in `bin`, used by every
     /// pass of the step: the positions move only at the end of the last pass).
     stencils: Vec<Stencil>,
+    tractions: Vec<Traction>,
+    traction_work: f64,
+    transfer: Transfer,
+    /// Force and point position of each traction as applied this step.
+    traction_applied: Vec<([f64; 2], [f64; 2])>,
+    inverse: Vec<u32>,
 }
 
 /// Stencil of a point: first node (i, j) and 1-D weights and derivatives.
@@ -275,6 +324,11 @@ impl Mpm {
             scratch: PermuteScratch::default(),
             mass_eps,
             stencils: vec![Stencil::default(); n],
+            tractions: Vec::new(),
+            traction_work: 0.0,
+            transfer: Transfer::Flip,
+            traction_applied: Vec::new(),
+            inverse: Vec::new(),
         };
         // The stress work starts at the initial elastic energy (so plastic = work − elastic).
         for p in 0..n {
@@ -284,6 +338,47 @@ impl Mpm {
         mpm.resort();
         mpm.bin()?;
         Ok(mpm)
+    }
+
+    /// Choose the velocity transfer. APIC is refused with standard MPM shape functions (D_p is
+    /// singular on node lines) or a PIC fraction > 0 (APIC has none), naming the field.
+    pub fn set_transfer(&mut self, transfer: Transfer) -> Result<()> {
+        if transfer == Transfer::Apic {
+            if self.params.shape != ShapeKind::Gimp {
+                return Err(Error::config(
+                    "mpm.transfer",
+                    "APIC needs uGIMP shape functions (with the hat D_p = 0 on node lines)",
+                ));
+            }
+            if self.params.pic_fraction != 0.0 {
+                return Err(Error::config(
+                    "mpm.pic_fraction",
+                    "must be 0 with the APIC transfer",
+                ));
+            }
+        }
+        self.transfer = transfer;
+        for b in self.points.affine.iter_mut() {
+            *b = [0.0; 4];
+        }
+        Ok(())
+    }
+
+    /// The velocity transfer in use.
+    pub fn transfer(&self) -> Transfer {
+        self.transfer
+    }
+
+    /// Total angular momentum about the origin (per m), Σ_p m_p (x_p × v_p + B_p,yx − B_p,xy)
+    /// (the affine term is zero with FLIP/PIC).
+    pub fn angular_momentum(&self) -> f64 {
+        let p = &self.points;
+        (0..p.len())
+            .map(|q| {
+                let (x, v, b) = (p.pos[q], p.vel[q], p.affine[q]);
+                p.mass[q] * (x[0] * v[1] - x[1] * v[0] + b[2] - b[1])
+            })
+            .sum()
     }
 
     /// The time step in use (s).
@@ -306,6 +401,117 @@ impl Mpm {
             self.points.work[p] =
                 self.points.vol[p] * self.material.elastic_energy_density(&self.points.stress[p]);
         }
+    }
+
+    /// Add pressure loads on boundary faces of points. Refuses a point index out of range, a
+    /// normal that is not ±x or ±y, a pressure that is not finite, or a face outside the grid.
+    pub fn add_tractions(&mut self, loads: impl IntoIterator<Item = Traction>) -> Result<()> {
+        for t in loads {
+            if t.point as usize >= self.points.len() {
+                return Err(Error::Other(format!(
+                    "traction on point {} of {}",
+                    t.point,
+                    self.points.len()
+                )));
+            }
+            let axis_aligned = matches!(
+                t.normal,
+                [1.0, 0.0] | [-1.0, 0.0] | [0.0, 1.0] | [0.0, -1.0]
+            );
+            if !axis_aligned || !t.pressure.is_finite() {
+                return Err(Error::Other(format!(
+                    "traction normal must be ±x or ±y and the pressure finite, got {:?}, {}",
+                    t.normal, t.pressure
+                )));
+            }
+            self.tractions.push(t);
+        }
+        self.bin()
+    }
+
+    /// The traction loads (point indices as the points are ordered now).
+    pub fn tractions(&self) -> &[Traction] {
+        &self.tractions
+    }
+
+    /// Force of a traction load and its face's node stencil (first node and 1-D weights).
+    #[inline]
+    fn traction_force(&self, t: &Traction) -> ([f64; 2], Stencil) {
+        let q = t.point as usize;
+        let g = &self.grid;
+        let (x, lp, f) = (
+            self.points.pos[q],
+            self.points.half_size[q],
+            self.points.def_grad[q],
+        );
+        // cof F = J F⁻ᵀ = [[F_yy, −F_yx], [−F_xy, F_xx]] with F = (xx, xy, yx, yy).
+        let n = t.normal;
+        let cn = [f[3] * n[0] - f[2] * n[1], -f[1] * n[0] + f[0] * n[1]];
+        let scale = -t.pressure * 2.0 * lp;
+        let force = [scale * cn[0], scale * cn[1]];
+        // Face line along the normal: hat weights; along the face: uGIMP weights.
+        let hat = |c: f64| -> (i64, [f64; 3]) {
+            let r = c / g.h;
+            let i = r.floor();
+            (i as i64, [1.0 - (r - i), r - i, 0.0])
+        };
+        let local = [x[0] - g.origin[0], x[1] - g.origin[1]];
+        let mut st = Stencil::default();
+        if n[0] != 0.0 {
+            (st.i0, st.wx) = hat(local[0] + n[0] * lp);
+            (st.j0, st.wy, _) = weights_1d(ShapeKind::Gimp, local[1], g.h, lp);
+        } else {
+            (st.i0, st.wx, _) = weights_1d(ShapeKind::Gimp, local[0], g.h, lp);
+            (st.j0, st.wy) = hat(local[1] + n[1] * lp);
+        }
+        (force, st)
+    }
+
+    /// Add the traction forces to the nodal forces (after a force P2G).
+    fn scatter_tractions(&mut self) {
+        let nny = self.grid.ny + 1;
+        self.traction_applied.clear();
+        for k in 0..self.tractions.len() {
+            let (f, st) = self.traction_force(&self.tractions[k]);
+            let x = self.face_centre(&self.tractions[k]);
+            self.traction_applied.push((f, x));
+            for a in 0..3 {
+                for b in 0..3 {
+                    let w = st.wx[a] * st.wy[b];
+                    let node = (st.i0 as usize + a) * nny + st.j0 as usize + b;
+                    self.grid.sums[node][3] += w * f[0];
+                    self.grid.sums[node][4] += w * f[1];
+                }
+            }
+        }
+    }
+
+    /// Centre of a traction's face in the current configuration, x_p + F N l_p.
+    fn face_centre(&self, t: &Traction) -> [f64; 2] {
+        let q = t.point as usize;
+        let (x, f, lp, n) = (
+            self.points.pos[q],
+            self.points.def_grad[q],
+            self.points.half_size[q],
+            t.normal,
+        );
+        [
+            x[0] + lp * (f[0] * n[0] + f[1] * n[1]),
+            x[1] + lp * (f[2] * n[0] + f[3] * n[1]),
+        ]
+    }
+
+    /// Book the work of the traction forces over the step, f · Δx_face with f as applied and
+    /// the displacement of the face centre x_p + F N l_p (nodal velocities are not used: nodes
+    /// that hold a sliver of a point's domain have tiny masses and unreliable velocities, and
+    /// booking f·v at the nodes over-counted the work by ≈ 30 % in the biaxial test).
+    fn book_traction_work(&mut self) {
+        let mut work = 0.0;
+        for (t, (f, x0)) in self.tractions.iter().zip(&self.traction_applied) {
+            let x = self.face_centre(t);
+            work += f[0] * (x[0] - x0[0]) + f[1] * (x[1] - x0[1]);
+        }
+        self.traction_work += work;
     }
 
     /// Re-sort the points into cell order (x-major, as the nodes).
@@ -337,6 +543,16 @@ impl Mpm {
         }
         let perm = std::mem::take(&mut self.perm);
         self.points.permute(&perm, &mut self.scratch);
+        if !self.tractions.is_empty() {
+            // Old index perm[k] is now k.
+            self.inverse.resize(perm.len(), 0);
+            for (k, &old) in perm.iter().enumerate() {
+                self.inverse[old as usize] = k as u32;
+            }
+            for t in &mut self.tractions {
+                t.point = self.inverse[t.point as usize];
+            }
+        }
         self.perm = perm;
     }
 
@@ -383,6 +599,18 @@ impl Mpm {
         for s in 0..ns {
             self.stripe_start[s + 1] += self.stripe_start[s];
         }
+        for t in &self.tractions {
+            let (_, st) = self.traction_force(t);
+            if st.i0 < 0 || st.j0 < 0 || st.i0 + 2 > g.nx as i64 || st.j0 + 2 > g.ny as i64 {
+                return Err(Error::Unstable {
+                    step: self.steps,
+                    time: self.time,
+                    x: st.i0.max(0) as usize,
+                    y: st.j0.max(0) as usize,
+                    reason: format!("the traction face of point {} left the grid", t.point),
+                });
+            }
+        }
         // Stable scatter: within a stripe the points keep their (cell) order.
         let mut fill = std::mem::take(&mut self.perm);
         fill.clear();
@@ -398,6 +626,8 @@ impl Mpm {
 
     /// Scatter point quantities to the nodes. `mass`: mass and momentum; `force`: internal and
     /// gravity force; `momentum`: momentum only (MUSL re-map; mass kept).
+    // The stencil loops index several 3-arrays (weights, gradients, offsets) by node.
+    #[allow(clippy::needless_range_loop)]
     fn p2g(&mut self, mass: bool, force: bool, momentum: bool) {
         let g = &mut self.grid;
         let nny = g.ny + 1;
@@ -406,6 +636,8 @@ impl Mpm {
         let (order, starts) = (&self.order, &self.stripe_start);
         let stencils = &self.stencils;
         let ns = starts.len() - 1;
+        let apic = self.transfer == Transfer::Apic && (mass || momentum);
+        let (origin, h) = (g.origin, g.h);
         g.sums.par_iter_mut().for_each(|s| {
             if mass {
                 s[0] = 0.0;
@@ -438,6 +670,20 @@ impl Mpm {
                         let v = pts.vel[q];
                         let vol = pts.vol[q];
                         let sg = pts.stress[q];
+                        // APIC: C = B D⁻¹ with D = diag(Σ w_x d_x², Σ w_y d_y²) here.
+                        let (mut c, mut dx, mut dy) = ([0.0; 4], [0.0; 3], [0.0; 3]);
+                        if apic {
+                            let x = pts.pos[q];
+                            let (mut ddx, mut ddy) = (0.0, 0.0);
+                            for k in 0..3 {
+                                dx[k] = origin[0] + (st.i0 + k as i64) as f64 * h - x[0];
+                                dy[k] = origin[1] + (st.j0 + k as i64) as f64 * h - x[1];
+                                ddx += st.wx[k] * dx[k] * dx[k];
+                                ddy += st.wy[k] * dy[k] * dy[k];
+                            }
+                            let bm = pts.affine[q];
+                            c = [bm[0] / ddx, bm[1] / ddy, bm[2] / ddx, bm[3] / ddy];
+                        }
                         for a in 0..3 {
                             let base = (st.i0 + a as i64 - col0) as usize * nny + st.j0 as usize;
                             for b in 0..3 {
@@ -446,7 +692,14 @@ impl Mpm {
                                 if mass {
                                     node[0] += w * m;
                                 }
-                                if mass || momentum {
+                                if apic {
+                                    let u = [
+                                        v[0] + c[0] * dx[a] + c[1] * dy[b],
+                                        v[1] + c[2] * dx[a] + c[3] * dy[b],
+                                    ];
+                                    node[1] += w * m * u[0];
+                                    node[2] += w * m * u[1];
+                                } else if mass || momentum {
                                     node[1] += w * m * v[0];
                                     node[2] += w * m * v[1];
                                 }
@@ -537,6 +790,7 @@ impl Mpm {
         };
         let dt = self.dt;
         let pic = self.params.pic_fraction;
+        let apic = self.transfer == Transfer::Apic;
         let mat = &self.material;
         let do_v = matches!(
             pass,
@@ -562,82 +816,100 @@ impl Mpm {
             p.work.par_chunks_mut(CHUNK),
             p.vol0.par_chunks(CHUNK),
             stencils.par_chunks(CHUNK),
+            p.affine.par_chunks_mut(CHUNK),
         )
             .into_par_iter()
             .enumerate()
-            .map(|(k, (pos, vel, fg, vol, sig, state, work, vol0, sts))| {
-                let mut bad = None;
-                for q in 0..pos.len() {
-                    let st = &sts[q];
-                    let mut dv = [0.0; 2];
-                    let mut xn = [0.0; 2];
-                    let mut l = [0.0; 4];
-                    for a in 0..3 {
-                        let base = (st.i0 + a as i64) as usize * nny + st.j0 as usize;
-                        for b in 0..3 {
-                            let n = base + b;
-                            let w = st.wx[a] * st.wy[b];
-                            if do_v {
-                                dv[0] += w * (vnew[n][0] - vold[n][0]);
-                                dv[1] += w * (vnew[n][1] - vold[n][1]);
-                            }
-                            if do_x || pic > 0.0 {
-                                xn[0] += w * vnew[n][0];
-                                xn[1] += w * vnew[n][1];
-                            }
-                            if do_s {
-                                let gx = st.gx[a] * st.wy[b];
-                                let gy = st.wx[a] * st.gy[b];
-                                let v = vstrain[n];
-                                l[0] += v[0] * gx;
-                                l[1] += v[0] * gy;
-                                l[2] += v[1] * gx;
-                                l[3] += v[1] * gy;
+            .map(
+                |(k, (pos, vel, fg, vol, sig, state, work, vol0, sts, aff))| {
+                    let mut bad = None;
+                    for q in 0..pos.len() {
+                        let st = &sts[q];
+                        let mut dv = [0.0; 2];
+                        let mut xn = [0.0; 2];
+                        let mut l = [0.0; 4];
+                        let mut bm = [0.0; 4];
+                        for a in 0..3 {
+                            let base = (st.i0 + a as i64) as usize * nny + st.j0 as usize;
+                            for b in 0..3 {
+                                let n = base + b;
+                                let w = st.wx[a] * st.wy[b];
+                                if do_v {
+                                    dv[0] += w * (vnew[n][0] - vold[n][0]);
+                                    dv[1] += w * (vnew[n][1] - vold[n][1]);
+                                }
+                                if do_x || pic > 0.0 || apic {
+                                    xn[0] += w * vnew[n][0];
+                                    xn[1] += w * vnew[n][1];
+                                }
+                                if apic && do_v {
+                                    let d = [
+                                        origin[0] + (st.i0 + a as i64) as f64 * h - pos[q][0],
+                                        origin[1] + (st.j0 + b as i64) as f64 * h - pos[q][1],
+                                    ];
+                                    let u = vnew[n];
+                                    bm[0] += w * u[0] * d[0];
+                                    bm[1] += w * u[0] * d[1];
+                                    bm[2] += w * u[1] * d[0];
+                                    bm[3] += w * u[1] * d[1];
+                                }
+                                if do_s {
+                                    let gx = st.gx[a] * st.wy[b];
+                                    let gy = st.wx[a] * st.gy[b];
+                                    let v = vstrain[n];
+                                    l[0] += v[0] * gx;
+                                    l[1] += v[0] * gy;
+                                    l[2] += v[1] * gx;
+                                    l[3] += v[1] * gy;
+                                }
                             }
                         }
-                    }
-                    if do_v {
-                        // FLIP increment, blended with the PIC velocity Σ N v^{n+1}.
-                        vel[q][0] = (1.0 - pic) * (vel[q][0] + dv[0]) + pic * xn[0];
-                        vel[q][1] = (1.0 - pic) * (vel[q][1] + dv[1]) + pic * xn[1];
-                    }
-                    if do_s {
-                        let f = fg[q];
-                        let a = [1.0 + dt * l[0], dt * l[1], dt * l[2], 1.0 + dt * l[3]];
-                        let fnew = [
-                            a[0] * f[0] + a[1] * f[2],
-                            a[0] * f[1] + a[1] * f[3],
-                            a[2] * f[0] + a[3] * f[2],
-                            a[2] * f[1] + a[3] * f[3],
-                        ];
-                        let j = fnew[0] * fnew[3] - fnew[1] * fnew[2];
-                        if (j.is_nan() || j <= 0.0) && bad.is_none() {
-                            bad = Some((k * CHUNK + q, format!("det F = {j:e} ≤ 0")));
+                        if do_v && apic {
+                            vel[q] = xn;
+                            aff[q] = bm;
+                        } else if do_v {
+                            // FLIP increment, blended with the PIC velocity Σ N v^{n+1}.
+                            vel[q][0] = (1.0 - pic) * (vel[q][0] + dv[0]) + pic * xn[0];
+                            vel[q][1] = (1.0 - pic) * (vel[q][1] + dv[1]) + pic * xn[1];
                         }
-                        fg[q] = fnew;
-                        let vnew_ = j * vol0[q];
-                        let de = [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])];
-                        let spin = 0.5 * dt * (l[1] - l[2]);
-                        let s0 = sig[q];
-                        let s1 = mat.update_stress(&s0, &de, spin, &mut state[q]);
-                        let smid = [
-                            0.5 * (s0[0] + s1[0]),
-                            0.5 * (s0[1] + s1[1]),
-                            0.5 * (s0[2] + s1[2]),
-                        ];
-                        work[q] += 0.5
-                            * (vol[q] + vnew_)
-                            * (smid[0] * de[0] + smid[1] * de[1] + 2.0 * smid[2] * de[2]);
-                        sig[q] = s1;
-                        vol[q] = vnew_;
+                        if do_s {
+                            let f = fg[q];
+                            let a = [1.0 + dt * l[0], dt * l[1], dt * l[2], 1.0 + dt * l[3]];
+                            let fnew = [
+                                a[0] * f[0] + a[1] * f[2],
+                                a[0] * f[1] + a[1] * f[3],
+                                a[2] * f[0] + a[3] * f[2],
+                                a[2] * f[1] + a[3] * f[3],
+                            ];
+                            let j = fnew[0] * fnew[3] - fnew[1] * fnew[2];
+                            if (j.is_nan() || j <= 0.0) && bad.is_none() {
+                                bad = Some((k * CHUNK + q, format!("det F = {j:e} ≤ 0")));
+                            }
+                            fg[q] = fnew;
+                            let vnew_ = j * vol0[q];
+                            let de = [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])];
+                            let spin = 0.5 * dt * (l[1] - l[2]);
+                            let s0 = sig[q];
+                            let s1 = mat.update_stress(&s0, &de, spin, &mut state[q]);
+                            let smid = [
+                                0.5 * (s0[0] + s1[0]),
+                                0.5 * (s0[1] + s1[1]),
+                                0.5 * (s0[2] + s1[2]),
+                            ];
+                            work[q] += 0.5
+                                * (vol[q] + vnew_)
+                                * (smid[0] * de[0] + smid[1] * de[1] + 2.0 * smid[2] * de[2]);
+                            sig[q] = s1;
+                            vol[q] = vnew_;
+                        }
+                        if do_x {
+                            pos[q][0] += dt * xn[0];
+                            pos[q][1] += dt * xn[1];
+                        }
                     }
-                    if do_x {
-                        pos[q][0] += dt * xn[0];
-                        pos[q][1] += dt * xn[1];
-                    }
-                }
-                bad
-            })
+                    bad
+                },
+            )
             .find_any(|b| b.is_some())
             .flatten();
         if let Some((q, why)) = bad {
@@ -668,18 +940,21 @@ impl Mpm {
                 self.grid_velocity(true);
                 self.point_pass(PointPass::StressFromMap)?;
                 self.p2g(false, true, false);
+                self.scatter_tractions();
                 self.grid_velocity(false);
                 self.grid_update();
                 self.point_pass(PointPass::VelocityAndMove)?;
             }
             Scheme::Usl => {
                 self.p2g(true, true, false);
+                self.scatter_tractions();
                 self.grid_velocity(false);
                 self.grid_update();
                 self.point_pass(PointPass::All)?;
             }
             Scheme::Musl => {
                 self.p2g(true, true, false);
+                self.scatter_tractions();
                 self.grid_velocity(false);
                 self.grid_update();
                 self.point_pass(PointPass::Velocity)?;
@@ -687,6 +962,9 @@ impl Mpm {
                 self.grid_velocity(true);
                 self.point_pass(PointPass::StressFromMapAndMove)?;
             }
+        }
+        if !self.tractions.is_empty() {
+            self.book_traction_work();
         }
         self.time += self.dt;
         self.steps += 1;
@@ -741,6 +1019,7 @@ impl Mpm {
             boundary_normal: self.booked[0],
             boundary_friction: self.booked[1],
             damping: self.booked[2],
+            traction: self.traction_work,
         }
     }
 

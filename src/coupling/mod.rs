@@ -19,6 +19,7 @@ pub mod driver;
 pub mod ladd;
 pub mod overlap;
 pub mod validation;
+pub mod validation_ladd;
 
 pub use cover::{DiskCover, Grid};
 pub use driver::{subcycles, Coupled, Exchange};

@@ -19,7 +19,7 @@ use crate::validate::{Check, Fidelity, Plot, Report, Series, MAX_PLOT_POINTS, SA
 use crate::{Error, Result};
 
 /// A periodic `l × l` lattice in lattice units (Δx = Δt = ρ₀ = 1) with a uniform body force.
-fn periodic_fluid<T: Real>(
+pub(crate) fn periodic_fluid<T: Real>(
     l: usize,
     model: CollisionModel,
     tau: f64,

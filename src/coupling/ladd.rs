@@ -120,7 +120,10 @@ impl LaddMap {
             ((c % nx) as f64 + 0.5) * dx - g.x[k],
             ((c / nx) as f64 + 0.5) * dx - g.y[k],
         ];
-        for (a, (len, p)) in [(nx, periodic[0]), (ny, periodic[1])].into_iter().enumerate() {
+        for (a, (len, p)) in [(nx, periodic[0]), (ny, periodic[1])]
+            .into_iter()
+            .enumerate()
+        {
             if p {
                 let l = len as f64 * dx;
                 r[a] -= l * (r[a] / l).round();
@@ -177,7 +180,8 @@ impl LaddMap {
             }
         }
         self.inside.sort_unstable();
-        let vel = |k: usize, r: [f64; 2]| [g.vx[k] - g.omega[k] * r[1], g.vy[k] + g.omega[k] * r[0]];
+        let vel =
+            |k: usize, r: [f64; 2]| [g.vx[k] - g.omega[k] * r[1], g.vy[k] + g.omega[k] * r[0]];
         self.link_grain.clear();
         self.link_arm.clear();
         self.covered_grain.clear();
@@ -206,7 +210,10 @@ impl LaddMap {
                     continue;
                 }
                 // Mid-point x_f + e_i/2 = x_b − e_i/2.
-                let arm = [rb[0] - 0.5 * CX[i] as f64 * dx, rb[1] - 0.5 * CY[i] as f64 * dx];
+                let arm = [
+                    rb[0] - 0.5 * CX[i] as f64 * dx,
+                    rb[1] - 0.5 * CY[i] as f64 * dx,
+                ];
                 let u = vel(k, arm);
                 lc.cell.push(f as u32);
                 lc.dir.push(i as u8);
@@ -337,7 +344,11 @@ mod tests {
         let mut count = 0;
         for c in 0..20 * 16 {
             let r = map.arm(c, &g, 0);
-            assert_eq!(inside(c), r[0] * r[0] + r[1] * r[1] <= 2.3 * 2.3, "cell {c}");
+            assert_eq!(
+                inside(c),
+                r[0] * r[0] + r[1] * r[1] <= 2.3 * 2.3,
+                "cell {c}"
+            );
             count += inside(c) as usize;
         }
         assert_eq!(count, lc.inside.len());
@@ -346,7 +357,10 @@ mod tests {
         for k in 0..lc.cell.len() {
             let (c, i) = (lc.cell[k] as usize, lc.dir[k] as usize);
             assert!(!inside(c));
-            let (x, y) = ((c % 20) as i64 + CX[i] as i64, (c / 20) as i64 + CY[i] as i64);
+            let (x, y) = (
+                (c % 20) as i64 + CX[i] as i64,
+                (c / 20) as i64 + CY[i] as i64,
+            );
             let b = (y.rem_euclid(16) * 20 + x.rem_euclid(20)) as usize;
             assert!(inside(b));
             let rf = map.arm(c, &g, 0);

@@ -147,14 +147,18 @@ pub fn cylinder_array(fidelity: Fidelity) -> Result<Report> {
             reference,
             0.05,
         ));
-        // Steady momentum balance: link force = body force on the outside fluid; 0.5 %
-        // as for PSM (residual transient at the stopping criterion, f32 round-off).
+        // Steady momentum balance: link force = body force on the outside fluid. f64: 0.5 %
+        // as for PSM (residual transient at the stopping criterion). f32: 2 %, because the
+        // f32 lattice itself does not inject the nominal force here: the Guo increment
+        // 3 w_i e_i·F ≈ 1e-8 is at the round-off of populations ≈ 0.1, and a plain periodic
+        // 80² f32 fluid at this force gained 1.030× the nominal momentum over 1000 steps
+        // (f64: 1 + 3e-13). The link exchange itself is summed in f64 from the stored values.
         checks.push(Check::abs(
             case,
             &format!("grain force / body force at Φ = {phi}, {name}"),
             m.balance,
             1.0,
-            0.005,
+            if single { 0.02 } else { 0.005 },
         ));
         // The node mask's solid fraction differs from the nominal one (a staircase disk);
         // shown, not gated.
@@ -190,9 +194,8 @@ pub fn settling(fidelity: Fidelity) -> Result<Report> {
         Fidelity::Test => &[10, 20],
         Fidelity::Full => &[10, 20, 40],
     };
-    let ladd = |d| {
-        settling_disk_with::<f64, _>(d, 0.2, CollisionModel::Bgk, |g| LaddMap::new(g, 1.0))
-    };
+    let ladd =
+        |d| settling_disk_with::<f64, _>(d, 0.2, CollisionModel::Bgk, |g| LaddMap::new(g, 1.0));
     let runs: Vec<Settling> = sizes.iter().map(|&d| ladd(d)).collect::<Result<_>>()?;
     let psm = settling_disk::<f64>(20, 0.2, CollisionModel::Bgk)?;
     let mut checks = Vec::new();
@@ -206,12 +209,22 @@ pub fn settling(fidelity: Fidelity) -> Result<Report> {
     }
     let n = runs.len();
     let (a, b) = (&runs[n - 2], &runs[n - 1]);
-    checks.push(Check::report(
-        case,
-        &format!("|Δu_t|/u_t between d = {} and d = {}", a.d, b.d),
-        ((b.u_t - a.u_t) / b.u_t).abs(),
-        0.02,
-    ));
+    if fidelity == Fidelity::Full {
+        // Issue 6: the change between d = 20 and d = 40 at most 2 %.
+        checks.push(Check::at_most(
+            case,
+            &format!("|Δu_t|/u_t between d = {} and d = {}", a.d, b.d),
+            ((b.u_t - a.u_t) / b.u_t).abs(),
+            0.02,
+        ));
+    } else {
+        checks.push(Check::report(
+            case,
+            &format!("|Δu_t|/u_t between d = {} and d = {}", a.d, b.d),
+            ((b.u_t - a.u_t) / b.u_t).abs(),
+            0.02,
+        ));
+    }
     let d20 = runs.iter().find(|s| s.d == 20).expect("d = 20 is run");
     // Faxén's Stokes drag between two walls (Re = 0.2): 2 % at d = 20, as for PSM.
     checks.push(Check::rel(
@@ -221,14 +234,22 @@ pub fn settling(fidelity: Fidelity) -> Result<Report> {
         1.0,
         0.02,
     ));
-    // The PSM terminal velocity at the same d (settling-disk): the two couplings agree
-    // within 2 %.
-    checks.push(Check::rel(
+    // Convergence: the staircase disk of the bounce-back converges at first order (error
+    // ratio ½ per doubling; measured 0.49 from d = 10 to 20); gated at 0.6.
+    checks.push(Check::at_most(
+        case,
+        &format!("|u_t/u_F − 1| at d = {} over that at d = {}", b.d, a.d),
+        (b.u_t - 1.0).abs() / (a.u_t - 1.0).abs(),
+        0.6,
+    ));
+    // The PSM terminal velocity at the same d (settling-disk), shown: the two methods
+    // approach Faxén from opposite sides (Ladd below, PSM above), so their ratio carries
+    // both errors.
+    checks.push(Check::report(
         case,
         &format!("u_t(Ladd)/u_t(PSM) at d = 20 (PSM: {:.4} u_F)", psm.u_t),
         d20.u_t / psm.u_t,
         1.0,
-        0.02,
     ));
     let mut plot = Plot::new(
         "ladd-settling-disk",

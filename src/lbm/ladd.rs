@@ -244,7 +244,11 @@ impl BounceLinks {
             if self.cb[k] == u32::MAX {
                 continue;
             }
-            let (cf, cb, i) = (self.cf[k] as usize, self.cb[k] as usize, self.dir[k] as usize);
+            let (cf, cb, i) = (
+                self.cf[k] as usize,
+                self.cb[k] as usize,
+                self.dir[k] as usize,
+            );
             let o = OPP[i];
             let ((sa, ca), (sb, cbb)) = if was_even {
                 ((o, cf), (i, cb))
@@ -353,7 +357,13 @@ mod tests {
             interpolated: false,
         }]);
         let mask = obs.mask(l, l);
-        let init = |x: usize, y: usize| (1.0 + 0.01 * (x as f64 / l as f64), 0.02, -0.01 * (y as f64 / l as f64));
+        let init = |x: usize, y: usize| {
+            (
+                1.0 + 0.01 * (x as f64 / l as f64),
+                0.02,
+                -0.01 * (y as f64 / l as f64),
+            )
+        };
         let mut solid = Lattice::<f64>::new(l, l, Edges::periodic(), mask.clone()).unwrap();
         solid.fill(init);
         obs.link(&solid);
@@ -375,9 +385,8 @@ mod tests {
             let s0 = links.sum.clone();
             open.step(&col);
             links.bounce(&mut open, even);
-            let df: [f64; 2] = std::array::from_fn(|a| {
-                links.sum.iter().zip(&s0).map(|(x, y)| x[a] - y[a]).sum()
-            });
+            let df: [f64; 2] =
+                std::array::from_fn(|a| links.sum.iter().zip(&s0).map(|(x, y)| x[a] - y[a]).sum());
             for a in 0..2 {
                 assert_relative_eq!(df[a], obs.force[0][a], epsilon = 1e-13);
             }
@@ -400,7 +409,10 @@ mod tests {
         use crate::lbm::{Collider, CollisionModel, MrtRates};
         let l = 20;
         let u = [0.04, -0.025];
-        for model in [CollisionModel::Bgk, CollisionModel::Mrt(MrtRates::standard(0.8))] {
+        for model in [
+            CollisionModel::Bgk,
+            CollisionModel::Mrt(MrtRates::standard(0.8)),
+        ] {
             let mut lat = Lattice::<f64>::new(l, l, Edges::periodic(), vec![false; l * l]).unwrap();
             lat.fill(|_, _| (1.0, u[0], u[1]));
             let col = Collider::new(model, 0.8, None, [0.0; 2]);

@@ -387,11 +387,11 @@ mod tests {
             links.bounce(&mut open, even);
             let df: [f64; 2] =
                 std::array::from_fn(|a| links.sum.iter().zip(&s0).map(|(x, y)| x[a] - y[a]).sum());
-            for a in 0..2 {
-                assert_relative_eq!(df[a], obs.force[0][a], epsilon = 1e-13);
+            for (d, o) in df.iter().zip(&obs.force[0]) {
+                assert_relative_eq!(*d, *o, epsilon = 1e-13);
             }
-            for k in 0..l * l {
-                if !mask[k] {
+            for (k, &m) in mask.iter().enumerate() {
+                if !m {
                     let (p, q) = (solid.populations(k), open.populations(k));
                     for i in 0..Q {
                         assert!((p[i] - q[i]).abs() < 1e-14, "step {step} cell {k} i {i}");

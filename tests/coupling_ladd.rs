@@ -40,6 +40,11 @@ fn ladd_momentum() {
     assert_passes("ladd-momentum");
 }
 
+#[test]
+fn ladd_force_noise() {
+    assert_passes("ladd-force-noise");
+}
+
 /// `Coupled<Lbm<f32>, Dem, LaddMap>` with MRT + LES: a grain moving and spinning through a
 /// closed box slows down (the fluid takes its momentum), the run stays finite, and the
 /// nodes it leaves are refilled (no node stays inside after it has gone).

@@ -349,6 +349,11 @@ pub const CASES: &[Case] = &[
         run: crate::coupling::validation_ladd::momentum,
     },
     Case {
+        name: "ladd-force-noise",
+        description: "towed disk: mean drag and per-step fluctuation, Ladd (± impulses) vs PSM",
+        run: crate::coupling::validation_ladd::force_noise,
+    },
+    Case {
         name: "mpm-selfweight",
         description: "elastic column under gravity: σ_yy = −ρg(H − y) within 2 % of ρgH",
         run: |f| checks_only(crate::mpm::validation::selfweight(f)),

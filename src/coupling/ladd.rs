@@ -197,6 +197,12 @@ impl LaddMap {
             }
             let (x, y) = ((cu % nx) as i64, (cu / nx) as i64);
             let rb = self.arm(cu, g, k);
+            // A node more than √2 cells inside its disk has all eight neighbours inside it:
+            // no link.
+            let deep = (self.radius_factor * g.radius[k] / dx - 1.5).max(0.0) * dx;
+            if rb[0] * rb[0] + rb[1] * rb[1] < deep * deep {
+                continue;
+            }
             for i in 1..Q {
                 // The outside node x_f = x_b − e_i.
                 let (Some(fx), Some(fy)) = (

@@ -287,6 +287,7 @@ mod tests {
         let f = CellForces {
             fx: c.eps.clone(),
             fy: vec![0.0; n],
+            ..Default::default()
         };
         let mut l = ExternalLoads::default();
         map.loads(&f, 1, &mut l);
@@ -303,7 +304,15 @@ mod tests {
             fy[k] = c.eps[k] * x;
             t += c.eps[k] * (x * x + y * y);
         }
-        map.loads(&CellForces { fx, fy }, 1, &mut l);
+        map.loads(
+            &CellForces {
+                fx,
+                fy,
+                ..Default::default()
+            },
+            1,
+            &mut l,
+        );
         assert!((l.torque[0] - t).abs() < 1e-9 * t);
         assert!(l.fx[0].abs() < 1e-9 && l.fy[0].abs() < 1e-9);
     }
@@ -338,6 +347,7 @@ mod tests {
             &CellForces {
                 fx: vec![1.0; n],
                 fy: vec![0.0; n],
+                ..Default::default()
             },
             2,
             &mut l,

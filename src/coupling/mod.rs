@@ -5,6 +5,8 @@
 //! * [`cover`]: grains → partially saturated cells (ε, solid velocity with rotation,
 //!   hydrodynamic radius factor r/R) and cell forces → force and torque per grain
 //!   (seed eq. 5.53–5.54). The collision of covered cells is in [`crate::lbm::partial`].
+//! * [`ladd`]: grains → boundary links for Ladd's modified bounce-back (seed eq. 5.45–5.49),
+//!   the alternative to partially saturated cells; link forces → force and torque per grain.
 //! * [`driver`]: the coupled step over two [`crate::scale::Scale`]s with solid sub-cycling
 //!   n_s = ⌊Δt/Δt_D⌋ + 1 and the hydrodynamic force held (seed eq. 5.61).
 //!
@@ -14,11 +16,14 @@
 pub mod bench;
 pub mod cover;
 pub mod driver;
+pub mod ladd;
 pub mod overlap;
 pub mod validation;
+pub mod validation_ladd;
 
 pub use cover::{DiskCover, Grid};
 pub use driver::{subcycles, Coupled, Exchange};
+pub use ladd::LaddMap;
 
 use crate::dem::scale::GrainView;
 use crate::dem::ExternalLoads;

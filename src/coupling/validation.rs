@@ -9,7 +9,7 @@
 //! * `coupling-momentum`: grains moving through a fluid at rest in a closed periodic box
 //!   without gravity: total momentum of fluid + grains is conserved to 1e-10 relative.
 
-use super::{Coupled, DiskCover, Grid};
+use super::{Coupled, DiskCover, Exchange, Grid};
 use crate::dem::{ContactParams, Dem, DemParams, Grains};
 use crate::lbm::{
     Collider, CollisionModel, Edges, Lattice, Lbm, MrtRates, Obstacles, Real, SolidCover,
@@ -19,7 +19,7 @@ use crate::validate::{Check, Fidelity, Plot, Report, Series, MAX_PLOT_POINTS, SA
 use crate::{Error, Result};
 
 /// A periodic `l × l` lattice in lattice units (Δx = Δt = ρ₀ = 1) with a uniform body force.
-fn periodic_fluid<T: Real>(
+pub(crate) fn periodic_fluid<T: Real>(
     l: usize,
     model: CollisionModel,
     tau: f64,
@@ -201,8 +201,9 @@ pub fn psm_cylinder_array(fidelity: Fidelity) -> Result<Report> {
     })
 }
 
-/// Total momentum (SI per unit depth) of fluid + grains of a coupled system.
-pub fn total_momentum<T: Real>(c: &Coupled<Lbm<T>, Dem, DiskCover>) -> [f64; 2] {
+/// Total momentum (SI per unit depth) of fluid + grains of a coupled system (nodes inside
+/// grains under Ladd's bounce-back are not fluid).
+pub fn total_momentum<T: Real, M>(c: &Coupled<Lbm<T>, Dem, M>) -> [f64; 2] {
     let u = c.fluid.units;
     let k = u.rho0 * u.dx.powi(3) / u.dt;
     let pf = c.fluid.momentum();
@@ -218,6 +219,16 @@ pub fn momentum_box<T: Real>(
     model: CollisionModel,
     les: Option<f64>,
     steps: u64,
+) -> Result<([f64; 2], f64, [f64; 2])> {
+    momentum_box_with::<T, _>(model, les, steps, |grid| DiskCover::new(grid, 1.0))
+}
+
+/// [`momentum_box`] with the grains mapped onto the fluid by `map(grid)`.
+pub fn momentum_box_with<T: Real, M: Exchange<Lbm<T>, Dem>>(
+    model: CollisionModel,
+    les: Option<f64>,
+    steps: u64,
+    map: impl FnOnce(Grid) -> Result<M>,
 ) -> Result<([f64; 2], f64, [f64; 2])> {
     let l = 64;
     let tau = 0.8;
@@ -244,8 +255,7 @@ pub fn momentum_box<T: Real>(
         dx: 1.0,
         periodic: [true, true],
     };
-    let map = DiskCover::new(grid, 1.0)?;
-    let mut c = Coupled::new(fluid, dem, map);
+    let mut c = Coupled::new(fluid, dem, map(grid)?);
     let p0 = total_momentum(&c);
     let mut dev: f64 = 0.0;
     for _ in 0..steps {
@@ -329,6 +339,16 @@ pub struct Settling {
 /// scaling: the same dimensionless problem at every d) until the velocity changes by less
 /// than 1e-4 relative over 0.05 d²/ν, or the disk is 3d above the floor.
 pub fn settling_disk<T: Real>(d: usize, re_f: f64, model: CollisionModel) -> Result<Settling> {
+    settling_disk_with::<T, _>(d, re_f, model, |grid| DiskCover::new(grid, 1.0))
+}
+
+/// [`settling_disk`] with the grain mapped onto the fluid by `map(grid)`.
+pub fn settling_disk_with<T: Real, M: Exchange<Lbm<T>, Dem>>(
+    d: usize,
+    re_f: f64,
+    model: CollisionModel,
+    map: impl FnOnce(Grid) -> Result<M>,
+) -> Result<Settling> {
     let tau = 0.8;
     let nu = (tau - 0.5) / 3.0;
     let (nx, ny) = (4 * d, 16 * d);
@@ -369,7 +389,7 @@ pub fn settling_disk<T: Real>(d: usize, re_f: f64, model: CollisionModel) -> Res
         dx: 1.0,
         periodic: [false, false],
     };
-    let mut c = Coupled::new(fluid, dem, DiskCover::new(grid, 1.0)?);
+    let mut c = Coupled::new(fluid, dem, map(grid)?);
     let t_unit = (d * d) as f64 / nu;
     let window = ((0.05 * t_unit) as u64).max(1);
     let mut history = Vec::new();

@@ -684,6 +684,67 @@ impl<T: Real> Lattice<T> {
         }
     }
 
+    /// The fluid node at x_c + e_i as the streaming sees it (wrapped across periodic edges),
+    /// or `None` when that link ends at a wall, a solid or an open edge, or `c` is solid.
+    pub(crate) fn fluid_neighbour(&self, c: usize, i: usize) -> Option<usize> {
+        if self.solid[c] {
+            return None;
+        }
+        let s = self.special_of[c];
+        if s != u32::MAX {
+            return match self.specials[s as usize].nb[i] {
+                Neighbour::Fluid(k) => Some(k as usize),
+                _ => None,
+            };
+        }
+        // A bulk node: its eight neighbours are fluid, x ± 1 in the row, y wrapped.
+        let (x, y) = ((c % self.nx) as i64, (c / self.nx) as i64);
+        let yy = (y + CY[i] as i64).rem_euclid(self.ny as i64);
+        Some((yy * self.nx as i64 + x + CX[i] as i64) as usize)
+    }
+
+    /// Overwrite the pre-collision populations of fluid cell `c` (what the next step
+    /// collides; the inverse of [`Lattice::populations`]). Populations arriving across an
+    /// open (Zou–He) link are not stored: the closure sets them. Solid cells are left alone.
+    pub(crate) fn set_populations(&mut self, c: usize, p: &[f64; Q]) {
+        if self.solid[c] {
+            return;
+        }
+        let n = self.stride;
+        let s = self.special_of[c];
+        for j in 0..Q {
+            // f_j arrives from x − e_j, across link ī (as in `gather`).
+            let slot = if s != u32::MAX {
+                match self.specials[s as usize].nb[OPP[j]] {
+                    Neighbour::Fluid(k) => {
+                        if self.even {
+                            j * n + c
+                        } else {
+                            OPP[j] * n + k as usize
+                        }
+                    }
+                    Neighbour::Bounce(w) => {
+                        let v = if self.even {
+                            p[j]
+                        } else {
+                            p[j] - self.wall_corr[w as usize][j].f64()
+                        };
+                        self.f[j * n + c] = T::c(v);
+                        continue;
+                    }
+                    Neighbour::Open => continue,
+                }
+            } else if self.even {
+                j * n + c
+            } else {
+                let (x, y) = ((c % self.nx) as i64, (c / self.nx) as i64);
+                let sy = (y - CY[j] as i64).rem_euclid(self.ny as i64);
+                OPP[j] * n + (sy * self.nx as i64 + x - CX[j] as i64) as usize
+            };
+            self.f[slot] = T::c(p[j]);
+        }
+    }
+
     /// Raw slot A[c][i] (for momentum exchange and interpolated bounce-back).
     #[inline]
     pub(crate) fn slot(&self, i: usize, c: usize) -> T {

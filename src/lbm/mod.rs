@@ -6,11 +6,13 @@
 //! * [`boundary`]: periodic, half-way bounce-back (resting or moving), Zou–He edges.
 //! * [`obstacle`]: shapes, interpolated bounce-back, momentum-exchange forces.
 //! * [`partial`]: partially saturated cells (Noble–Torczynski) for moving solids.
+//! * [`ladd`]: Ladd's modified bounce-back for moving solids (the alternative to [`partial`]).
 //! * [`solver`]: the solver in time, its [`Scale`](crate::scale::Scale) implementation.
 
 pub mod boundary;
 pub mod collision;
 pub mod d2q9;
+pub mod ladd;
 pub mod lattice;
 pub mod obstacle;
 pub mod partial;
@@ -19,6 +21,7 @@ pub mod solver;
 
 pub use boundary::{Edge, Edges};
 pub use collision::{Collider, CollisionModel, MrtRates};
+pub use ladd::{BounceLinks, LinkCover, LinkForces};
 pub use lattice::Lattice;
 pub use obstacle::{Obstacle, Obstacles, Shape};
 pub use partial::{CellForces, PartialCells, SolidCover};

@@ -43,6 +43,8 @@ pub struct SolidCover {
     pub ux: Vec<f64>,
     /// Solid velocity y (m/s).
     pub uy: Vec<f64>,
+    /// Boundary links for Ladd's bounce-back ([`super::ladd`]; empty under PSM).
+    pub links: super::ladd::LinkCover,
 }
 
 /// What the fluid hands back: the hydrodynamic force on the solid in each covered cell
@@ -53,6 +55,8 @@ pub struct CellForces {
     pub fx: Vec<f64>,
     /// Force y.
     pub fy: Vec<f64>,
+    /// Forces across Ladd's boundary links ([`super::ladd`]; empty under PSM).
+    pub links: super::ladd::LinkForces,
 }
 
 /// The partially covered cells of a lattice for one step, structure of arrays.

@@ -3,6 +3,7 @@
 
 use super::collision::Collider;
 use super::d2q9::{CX, CY, Q};
+use super::ladd::BounceLinks;
 use super::lattice::Lattice;
 use super::obstacle::Obstacles;
 use super::partial::{self, CellForces, PartialCells, SolidCover};
@@ -77,6 +78,8 @@ pub struct Lbm<T> {
     /// Momentum exchanged per covered cell summed over the steps of the last
     /// [`Scale::advance`], and their number.
     exchange_sum: (Vec<[f64; 2]>, u64),
+    /// Boundary links of moving solids under Ladd's bounce-back (empty: none).
+    pub ladd: BounceLinks,
 }
 
 impl<T: Real> Lbm<T> {
@@ -97,6 +100,7 @@ impl<T: Real> Lbm<T> {
             steps: 0,
             partial: PartialCells::new(),
             exchange_sum: (Vec::new(), 0),
+            ladd: BounceLinks::default(),
         }
     }
 
@@ -107,6 +111,9 @@ impl<T: Real> Lbm<T> {
             self.lattice.step(&self.collider);
         } else {
             self.lattice.step_partial(&self.collider, &mut self.partial);
+        }
+        if !self.ladd.is_empty() {
+            self.ladd.bounce(&mut self.lattice, was_even);
         }
         self.obstacles.after_step(&mut self.lattice, was_even);
         self.steps += 1;
@@ -146,13 +153,14 @@ impl<T: Real> Lbm<T> {
     }
 
     /// Total fluid momentum Σ_cells Σ_i f_i e_i (lattice units, pre-collision, without the
-    /// half-force shift), accumulated in f64.
+    /// half-force shift), accumulated in f64. Nodes inside solids under Ladd's bounce-back
+    /// ([`Lbm::ladd`]) are not fluid and not counted.
     pub fn momentum(&self) -> [f64; 2] {
         use rayon::prelude::*;
         let lat = &self.lattice;
         (0..lat.len())
             .into_par_iter()
-            .filter(|&c| !lat.is_solid(c))
+            .filter(|&c| !lat.is_solid(c) && !self.ladd.is_inside(c))
             .map(|c| {
                 let f = lat.populations(c);
                 let mut j = [0.0; 2];
@@ -318,6 +326,9 @@ impl<T: Real> Scale for Lbm<T> {
             )));
         }
         self.set_cover(input);
+        if !(input.links.is_empty() && self.ladd.is_empty()) {
+            self.ladd.set(&mut self.lattice, &input.links, &self.units);
+        }
         let (sum, count) = &mut self.exchange_sum;
         sum.clear();
         sum.resize(input.cells.len(), [0.0; 2]);
@@ -343,6 +354,7 @@ impl<T: Real> Scale for Lbm<T> {
             out.fx.push(-self.units.force_to_si(s[0] / k));
             out.fy.push(-self.units.force_to_si(s[1] / k));
         }
+        self.ladd.observe(&self.units, &mut out.links);
     }
     fn snapshot(&self) -> LbmSnapshot<T> {
         let (populations, next_even) = self.lattice.state();

@@ -344,6 +344,26 @@ pub const CASES: &[Case] = &[
         run: crate::coupling::validation::dkt,
     },
     Case {
+        name: "ladd-cylinder-array",
+        description: "Ladd's bounce-back: Sangani–Acrivos drag within 5 %, d ≥ 20 cells",
+        run: crate::coupling::validation_ladd::cylinder_array,
+    },
+    Case {
+        name: "ladd-settling-disk",
+        description: "Ladd's bounce-back: settling disk vs Faxén and the PSM terminal velocity",
+        run: crate::coupling::validation_ladd::settling,
+    },
+    Case {
+        name: "ladd-momentum",
+        description: "Ladd's bounce-back: fluid + grain momentum in a periodic box, with/without impulses",
+        run: crate::coupling::validation_ladd::momentum,
+    },
+    Case {
+        name: "ladd-force-noise",
+        description: "towed disk: mean drag and per-step fluctuation, Ladd (± impulses) vs PSM",
+        run: crate::coupling::validation_ladd::force_noise,
+    },
+    Case {
         name: "mpm-selfweight",
         description: "elastic column under gravity: σ_yy = −ρg(H − y) within 2 % of ρgH",
         run: |f| checks_only(crate::mpm::validation::selfweight(f)),

@@ -5,6 +5,8 @@
 //! * [`cover`]: grains → partially saturated cells (ε, solid velocity with rotation,
 //!   hydrodynamic radius factor r/R) and cell forces → force and torque per grain
 //!   (seed eq. 5.53–5.54). The collision of covered cells is in [`crate::lbm::partial`].
+//! * [`scenario`], [`run`]: the submerged column collapse (TOML with `[fluid]` and
+//!   `[coupling]` tables, `granflow check` / `granflow run`).
 //! * [`driver`]: the coupled step over two [`crate::scale::Scale`]s with solid sub-cycling
 //!   n_s = ⌊Δt/Δt_D⌋ + 1 and the hydrodynamic force held (seed eq. 5.61).
 //!
@@ -15,6 +17,8 @@ pub mod bench;
 pub mod cover;
 pub mod driver;
 pub mod overlap;
+pub mod run;
+pub mod scenario;
 pub mod validation;
 
 pub use cover::{DiskCover, Grid};

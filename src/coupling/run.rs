@@ -14,7 +14,7 @@
 //!   (J), `max_mach`.
 //! * `summary.json`: the collapse outcome ([`CollapseOutcome`], `energy_budget_error` null:
 //!   the work of the fluid is not tracked), grains, packing, and the fluid set-up and pore
-//!   pressure extremes ([`FluidSummary`]).
+//!   pressure means ([`FluidSummary`]).
 //!
 //! **Excess pore pressure under the column** (`pore_pressure_base`): the mean of
 //! p_e = c_s² (ρ − 1) (lattice, converted to Pa) over the lattice cells whose centre lies in the
@@ -112,12 +112,14 @@ pub struct FluidSummary {
     pub max_mach: f64,
     /// Pressure scale (ρ_s − ρ_f) φ g H_i (Pa): the buoyant weight of the column per area.
     pub pressure_scale: f64,
-    /// Mean base excess pore pressure over 0 < t ≤ 1 τ_c (Pa).
+    /// Period of the slowest acoustic mode of the closed tank, T_a = 2 max(L_box, depth)/c_s
+    /// with c_s = Δx/(√3 Δt) the lattice sound speed, in τ_c. The weakly compressible liquid
+    /// sloshes at this period; means over it remove that mode from the pore pressure.
+    pub acoustic_period_tc: f64,
+    /// Mean base excess pore pressure over 0 < t ≤ T_a (Pa): the "early" value.
     pub pore_pressure_early_mean: f64,
-    /// The base excess pore pressure of largest magnitude over 0 < t ≤ 2 τ_c (Pa).
-    pub pore_pressure_early_peak: f64,
-    /// Its time in τ_c.
-    pub pore_pressure_early_peak_tc: f64,
+    /// Mean base excess pore pressure over 0 < t ≤ 2 T_a (Pa).
+    pub pore_pressure_early_mean_2ta: f64,
     /// Lattice updates per second over the run (millions).
     pub mlups: f64,
 }
@@ -143,7 +145,7 @@ impl SubmergedSummary {
     pub fn done_line(&self) -> String {
         let c = &self.collapse;
         format!(
-            "done: a = {:.3}, L_f/L_i − 1 = {:.3}, H_f/L_i = {:.3}, spreading stopped at {:.2} τ_c, {} at {:.2} τ_c, {} grains, packing {:.3}, base pore pressure early: mean {:.3e} Pa, peak {:.3e} Pa at {:.2} τ_c, {:.1} s wall",
+            "done: a = {:.3}, L_f/L_i − 1 = {:.3}, H_f/L_i = {:.3}, spreading stopped at {:.2} τ_c, {} at {:.2} τ_c, {} grains, packing {:.3}, base pore pressure mean over the first acoustic period ({:.2} τ_c) {:.3e} Pa, over two {:.3e} Pa, {:.1} s wall",
             c.aspect_ratio,
             c.delta_l,
             c.h_f_over_l_i,
@@ -152,9 +154,9 @@ impl SubmergedSummary {
             c.rest_time_tc,
             self.grains,
             self.packing_fraction,
+            self.fluid.acoustic_period_tc,
             self.fluid.pore_pressure_early_mean,
-            self.fluid.pore_pressure_early_peak,
-            self.fluid.pore_pressure_early_peak_tc,
+            self.fluid.pore_pressure_early_mean_2ta,
             c.wall_time_s
         )
     }
@@ -241,13 +243,7 @@ impl FluidFields {
             * thickness
     }
 
-    fn write(
-        &self,
-        u: &crate::units::Units,
-        hydro: f64,
-        depth: f64,
-        path: &Path,
-    ) -> Result<()> {
+    fn write(&self, u: &crate::units::Units, hydro: f64, depth: f64, path: &Path) -> Result<()> {
         let (nx, ny) = (self.m.nx, self.m.ny);
         let v = u.velocity_to_si(1.0);
         let vel: Vec<[f64; 2]> = (0..nx * ny)
@@ -491,21 +487,16 @@ fn run_typed<T: Real>(
         particles: grains,
         energy_budget_error: f64::NAN,
     });
-    let early: Vec<f64> = pore
-        .iter()
-        .filter(|p| p.0 > 0.0 && p.0 <= tau_c)
-        .map(|p| p.1)
-        .collect();
-    let peak = pore
-        .iter()
-        .filter(|p| p.0 > 0.0 && p.0 <= 2.0 * tau_c)
-        .fold((0.0, 0.0), |a: (f64, f64), p| {
-            if p.1.abs() > a.1.abs() {
-                *p
-            } else {
-                a
-            }
-        });
+    let sound = u.dx / (3f64.sqrt() * dt);
+    let t_a = 2.0 * scenario.column.box_length.max(f.depth) / sound;
+    let mean_until = |t1: f64| {
+        let v: Vec<f64> = pore
+            .iter()
+            .filter(|p| p.0 > 0.0 && p.0 <= t1)
+            .map(|p| p.1)
+            .collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    };
     let summary = SubmergedSummary {
         collapse,
         grains,
@@ -529,9 +520,9 @@ fn run_typed<T: Real>(
                 * column.packing_fraction
                 * gmag
                 * h_i,
-            pore_pressure_early_mean: early.iter().sum::<f64>() / early.len().max(1) as f64,
-            pore_pressure_early_peak: peak.1,
-            pore_pressure_early_peak_tc: peak.0 / tau_c,
+            acoustic_period_tc: t_a / tau_c,
+            pore_pressure_early_mean: mean_until(t_a),
+            pore_pressure_early_mean_2ta: mean_until(2.0 * t_a),
             mlups: (nx * ny) as f64 * c.steps as f64 / wall_time_s.max(1e-9) / 1e6,
         },
     };

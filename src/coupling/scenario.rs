@@ -316,7 +316,10 @@ impl SubmergedScenario {
         let mut line = |k: &str, v: String| r.push_str(&format!("{k:<16}{v}\n"));
         line(
             "scenario",
-            format!("{} — {} (submerged column collapse)", self.name, self.description),
+            format!(
+                "{} — {} (submerged column collapse)",
+                self.name, self.description
+            ),
         );
         line("grains", format!("{}", d.dem.grains));
         line(
@@ -420,10 +423,18 @@ mod tests {
     #[test]
     fn refuses_bad_values_naming_the_field() {
         let cases = [
-            ("radius_factor = 0.8", "radius_factor = 1.2", "coupling.radius_factor"),
+            (
+                "radius_factor = 0.8",
+                "radius_factor = 1.2",
+                "coupling.radius_factor",
+            ),
             ("density = 1010.0", "density = 3000.0", "fluid.density"),
             ("method = \"psm\"", "method = \"ibm\"", "method"),
-            ("viscosity = 1.19e-5", "viscosity = -1.19e-5", "fluid.viscosity"),
+            (
+                "viscosity = 1.19e-5",
+                "viscosity = -1.19e-5",
+                "fluid.viscosity",
+            ),
             ("dx = 2.5e-4", "dx = 2.6e-4", "column.box_length"),
             ("tau = 0.53", "tau = 0.9", "coupling.dt"),
         ];

@@ -251,7 +251,7 @@ impl SubmergedScenario {
             }
         };
         let tau = units.tau(f.viscosity);
-        if !(tau > 0.5) {
+        if tau.is_nan() || tau <= 0.5 {
             return Err(Error::config(
                 "coupling.dt",
                 format!("gives τ = {tau} ≤ 1/2"),

@@ -1,13 +1,14 @@
 //! Figures of the submerged column collapse (docs/submerged.md) from run outputs.
 //!
-//! `cargo run --release --example submerged_figures -- RUNS FIGURES [SUFFIX]` reads
-//! `RUNS/{dry,loose,dense}_a0.8SUFFIX/{timeseries.csv,summary.json}` and writes
-//! `FIGURES/submerged-a0.8SUFFIX-pore-pressure.svg` (base excess pore pressure of the loose and
+//! `cargo run --release --example submerged_figures -- RUNS FIGURES [TAG]` (TAG `a0.8` if not
+//! given, e.g. `a4`, `a0.8_wide`) reads `RUNS/{dry,loose,dense}_TAG/{timeseries.csv,summary.json}`
+//! and writes `FIGURES/submerged-TAG-pore-pressure.svg` (base excess pore pressure of the loose and
 //! dense columns over the buoyant weight (ρ_s − ρ_f) φ g H_i, against t/τ_c) and
-//! `FIGURES/submerged-a0.8SUFFIX-runout.svg` ((L(t) − L_i)/L_i of all three), and prints one
+//! `FIGURES/submerged-TAG-runout.svg` ((L(t) − L_i)/L_i of all three), and prints one
 //! line per case: φ, ΔL, stop time, and the base pore pressure averaged over the first one and
 //! two acoustic periods T_a = 2 max(L_box, depth)/c_s of the tank (c_s = Δx/(√3 Δt)), in Pa
-//! and over the buoyant weight. The pore-pressure figure also shows its running mean over T_a.
+//! and over the buoyant weight, and over (0, t_r], t_r = 2 min(depth, L_box − L_i)/c_s the
+//! time the first pressure wave reflected by the lid or the far wall needs to come back. The pore-pressure figure also shows its running mean over T_a.
 
 use std::path::Path;
 
@@ -41,18 +42,17 @@ fn columns(path: &Path, names: &[&str]) -> Vec<Vec<f64>> {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let (runs, figs) = (Path::new(&args[1]), Path::new(&args[2]));
-    let suffix = args.get(3).map_or("", String::as_str);
+    let tag = args.get(3).map_or("a0.8", String::as_str);
     std::fs::create_dir_all(figs).unwrap();
-    let tag = format!("a0.8{suffix}");
     let mut pore = Plot::new(
         &format!("submerged-{tag}-pore-pressure"),
-        &format!("Excess pore pressure at the base under the column, a = 0.8{suffix}"),
+        &format!("Excess pore pressure at the base under the column, {tag}"),
         "t / τ_c",
         "p_e / ((ρ_s − ρ_f) φ g H_i)",
     );
     let mut runout = Plot::new(
         &format!("submerged-{tag}-runout"),
-        &format!("Run-out, a = 0.8{suffix}"),
+        &format!("Run-out, {tag}"),
         "t / τ_c",
         "(L(t) − L_i) / L_i",
     );
@@ -122,6 +122,15 @@ fn main() {
             v.iter().sum::<f64>() / v.len().max(1) as f64
         };
         let (m1, m2) = (mean(0.0, t_a), mean(0.0, 2.0 * t_a));
+        // Before the first pressure wave reflected by the lid or the far wall is back:
+        // t_r = 2 min(depth, L_box − L_i)/c_s.
+        let t_r =
+            2.0 * (cells[1] * dx).min(cells[0] * dx - l_i) / (dx / (3f64.sqrt() * dt)) / tau_c;
+        let m0 = mean(0.0, t_r);
+        println!(
+            "{case}: t_r = {t_r:.2} τ_c; base pore pressure mean over (0, t_r] = {m0:.2} Pa ({:.4})",
+            m0 / scale
+        );
         println!(
             "{case}: T_a = {t_a:.2} τ_c; base pore pressure mean over (0, T_a] = {m1:.2} Pa ({:.4} of (ρ_s − ρ_f)φgH_i = {scale:.1} Pa), over (0, 2T_a] = {m2:.2} Pa ({:.4})",
             m1 / scale,

@@ -283,3 +283,37 @@ fn tiny_collapse_runs_and_its_outputs_agree() {
         "run-out at 1.5 τ_c: submerged {l_sub}, dry {l_dry}"
     );
 }
+
+/// `granflow check` takes a file with a `[coupling]` table to the submerged scenario (not the
+/// DEM one, although it has `[grains]` too) and refuses bad input naming the field.
+#[test]
+fn cli_check_routes_submerged_files() {
+    let bin = env!("CARGO_BIN_EXE_granflow");
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/submerged/loose_a0.8.toml");
+    let out = std::process::Command::new(bin)
+        .arg("check")
+        .arg(&file)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    assert!(text.contains("submerged column collapse"), "{text}");
+    assert!(text.contains("sub-steps per lattice step"), "{text}");
+    assert!(text.trim_end().ends_with("ok"), "{text}");
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    let t = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(
+        &bad,
+        t.replacen("radius_factor = 0.8", "radius_factor = 0.0", 1),
+    )
+    .unwrap();
+    let out = std::process::Command::new(bin)
+        .arg("check")
+        .arg(&bad)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("coupling.radius_factor"), "{err}");
+}

@@ -317,3 +317,20 @@ fn cli_check_routes_submerged_files() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("coupling.radius_factor"), "{err}");
 }
+
+/// The other lattice options of the `[coupling]` table run through the same runner: f32
+/// populations, BGK, Smagorinsky LES (the thesis files use f32 + MRT + LES). 0.5 τ_c of the
+/// tiny column; the outputs are finite and the liquid moved.
+#[test]
+fn f32_bgk_les_variant_runs() {
+    let mut s = tiny();
+    s.coupling.precision = granflow::config::Precision::F32;
+    s.coupling.collision = granflow::config::CollisionKind::Bgk;
+    s.coupling.smagorinsky = Some(0.1);
+    s.time.end_tc = 0.5;
+    let dir = tempfile::tempdir().unwrap();
+    let r = run_submerged(&s, dir.path(), &mut |_, _| {}).unwrap();
+    assert_eq!(r.fluid.precision, "f32");
+    assert!(r.fluid.max_mach > 0.0 && r.fluid.max_mach < 0.5);
+    assert!(r.fluid.pore_pressure_early_mean.is_finite());
+}

@@ -420,7 +420,9 @@ fn run_typed<T: Real>(
         let mach = ff.max_mach();
         max_mach = max_mach.max(mach);
         let loads = c.solid_input();
-        let (drag_x, drag_y) = (loads.fx.iter().sum::<f64>(), loads.fy.iter().sum::<f64>());
+        // `+ 0.0`: an empty sum is −0.0 (before the first step).
+        let drag_x = loads.fx.iter().sum::<f64>() + 0.0;
+        let drag_y = loads.fy.iter().sum::<f64>() + 0.0;
         history.push((t, s.runout));
         pore.push((t, p_base));
         csv.row(&[

@@ -263,6 +263,14 @@ fn is_dem(path: &Path) -> bool {
         .is_some_and(|t| t.contains_key("grains"))
 }
 
+/// Is this a coupled (submerged) scenario (it has a `[coupling]` table)?
+fn is_submerged(path: &Path) -> bool {
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|t| t.parse::<toml::Table>().ok())
+        .is_some_and(|t| t.contains_key("coupling"))
+}
+
 /// Is this an MPM scenario (it has a `[material]` table)?
 fn is_mpm(path: &Path) -> bool {
     std::fs::read_to_string(path)
@@ -272,6 +280,11 @@ fn is_mpm(path: &Path) -> bool {
 }
 
 fn check(path: &Path) -> Result<ExitCode> {
+    if is_submerged(path) {
+        let s = granflow::coupling::scenario::SubmergedScenario::from_file(path)?;
+        print!("{}", s.check_report()?);
+        return Ok(ExitCode::SUCCESS);
+    }
     if is_dem(path) {
         return check_dem(path);
     }
@@ -480,6 +493,16 @@ fn run_dem(path: &Path, out: &Path) -> Result<ExitCode> {
 }
 
 fn run(path: &Path, out: &Path) -> Result<ExitCode> {
+    if is_submerged(path) {
+        let s = granflow::coupling::scenario::SubmergedScenario::from_file(path)?;
+        eprintln!("{}: submerged column collapse -> {}", s.name, out.display());
+        let r = with_progress((1e3 * s.time.end_tc) as u64, "milli-τ_c", |p| {
+            granflow::coupling::run::run_submerged(&s, out, p)
+        })
+        .with_context(|| stopped(path, out))?;
+        println!("{}", r.done_line());
+        return Ok(ExitCode::SUCCESS);
+    }
     if is_dem(path) {
         return run_dem(path, out);
     }

@@ -7,6 +7,8 @@
 //!   (seed eq. 5.53–5.54). The collision of covered cells is in [`crate::lbm::partial`].
 //! * [`ladd`]: grains → boundary links for Ladd's modified bounce-back (seed eq. 5.45–5.49),
 //!   the alternative to partially saturated cells; link forces → force and torque per grain.
+//! * [`scenario`], [`run`]: the submerged column collapse (TOML with `[fluid]` and
+//!   `[coupling]` tables, `granflow check` / `granflow run`).
 //! * [`driver`]: the coupled step over two [`crate::scale::Scale`]s with solid sub-cycling
 //!   n_s = ⌊Δt/Δt_D⌋ + 1 and the hydrodynamic force held (seed eq. 5.61).
 //!
@@ -18,6 +20,8 @@ pub mod cover;
 pub mod driver;
 pub mod ladd;
 pub mod overlap;
+pub mod run;
+pub mod scenario;
 pub mod validation;
 pub mod validation_ladd;
 

@@ -58,11 +58,11 @@ pub struct CollapseSummary {
     pub deposition_wall_time_s: f64,
 }
 
-/// Main mass, run-out, front, height, and contacts per grain.
-struct Shape {
-    runout: f64,
-    front: f64,
-    height: f64,
+/// Main mass, run-out, front, height (m), and contacts per grain.
+pub(crate) struct Shape {
+    pub(crate) runout: f64,
+    pub(crate) front: f64,
+    pub(crate) height: f64,
     contacts: Vec<f64>,
 }
 
@@ -78,7 +78,7 @@ fn find(parent: &mut [u32], mut a: u32) -> u32 {
 /// Measure the deposit shape (see the module doc): main mass by near-contacts found on a
 /// uniform grid of cells 2R_max(1 + [`CONNECT_GAP`]) wide, contact counts from the touching
 /// pairs.
-fn shape(dem: &Dem) -> Shape {
+pub(crate) fn shape(dem: &Dem) -> Shape {
     let g = &dem.grains;
     let n = g.len();
     let mut parent: Vec<u32> = (0..n as u32).collect();
@@ -166,12 +166,14 @@ fn shape(dem: &Dem) -> Shape {
     }
 }
 
-fn write_frame(
+/// Write frame `k` (grains as part 0, contacts as part 1) and list it in `pvd` at `time`.
+pub(crate) fn write_frame(
     dem: &Dem,
     s: &Shape,
     thickness: f64,
     dir: &Path,
     k: usize,
+    time: f64,
     pvd: &mut PvdSeries,
 ) -> Result<()> {
     let g = &dem.grains;
@@ -228,8 +230,8 @@ fn write_frame(
     ];
     let cells: &[Field] = if lines.is_empty() { &[] } else { &fields };
     write_vtu_points(&dir.join(&cname), &points, &[], &lines, cells)?;
-    pvd.add(dem.time(), 0, &gname)?;
-    pvd.add(dem.time(), 1, &cname)
+    pvd.add(time, 0, &gname)?;
+    pvd.add(time, 1, &cname)
 }
 
 /// Run the collapse described by `scenario`, writing into `out_dir` (created if missing).
@@ -312,6 +314,7 @@ pub fn run_column_collapse(
                 scenario.grains.thickness,
                 out_dir,
                 frame,
+                dem.time(),
                 &mut pvd,
             )?;
             frame += 1;
@@ -341,6 +344,7 @@ pub fn run_column_collapse(
             scenario.grains.thickness,
             out_dir,
             frame,
+            dem.time(),
             &mut pvd,
         )?;
     }

@@ -37,7 +37,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::scenario::{CouplingMethod, DerivedSubmerged, SubmergedScenario};
-use super::{reduced_gravity, Coupled, DiskCover, Exchange, Grid};
+use super::{reduced_gravity, Coupled, DiskCover, Exchange, Grid, LaddMap};
 use crate::analysis::runout::{CollapseOutcome, CollapseRecord};
 use crate::config::Precision;
 use crate::dem::packing::deposit_column;
@@ -53,12 +53,16 @@ use crate::scale::Scale;
 use crate::units::CS2;
 use crate::{Error, Result};
 
-/// Partially saturated cells for disks of axial length `thickness`: the lattice's forces per
-/// metre of depth × thickness are the forces on the grains (N, N·m).
+/// The grain ↔ lattice map for disks of axial length `thickness`: the lattice's forces per
+/// metre of depth × thickness are the forces on the grains (N, N·m). Partially saturated
+/// cells through `cover`, or Ladd's bounce-back links through `ladd` when set (`cover` then
+/// only gives the solid fraction written to the frames).
 #[derive(Clone, Debug)]
 pub struct SlabCover {
     /// The disk ↔ cell map.
     pub cover: DiskCover,
+    /// Ladd's link map, used instead of `cover` for the exchange when set.
+    pub ladd: Option<LaddMap>,
     /// Axial length of the disks (m).
     pub thickness: f64,
 }
@@ -69,11 +73,19 @@ where
     S: Scale<Input = ExternalLoads, Output = GrainView>,
 {
     fn to_fluid(&mut self, solid: &GrainView, fluid_in: &mut SolidCover) {
-        self.cover.cover(solid, fluid_in);
+        match &mut self.ladd {
+            Some(l) => Exchange::<F, S>::to_fluid(l, solid, fluid_in),
+            None => self.cover.cover(solid, fluid_in),
+        }
     }
     fn to_solid(&mut self, fluid: &CellForces, solid_in: &mut ExternalLoads) {
-        let n = self.cover.grains();
-        self.cover.loads(fluid, n, solid_in);
+        match &mut self.ladd {
+            Some(l) => Exchange::<F, S>::to_solid(l, fluid, solid_in),
+            None => {
+                let n = self.cover.grains();
+                self.cover.loads(fluid, n, solid_in);
+            }
+        }
         let w = self.thickness;
         for v in [&mut solid_in.fx, &mut solid_in.fy, &mut solid_in.torque] {
             v.iter_mut().for_each(|x| *x *= w);
@@ -332,11 +344,14 @@ fn run_typed<T: Real>(
         dx: u.dx,
         periodic: [false, false],
     };
-    let map = match scenario.coupling.method {
-        CouplingMethod::Psm => SlabCover {
-            cover: DiskCover::new(grid, scenario.coupling.radius_factor)?,
-            thickness: scenario.grains.thickness,
+    let r = scenario.coupling.radius_factor;
+    let map = SlabCover {
+        cover: DiskCover::new(grid, r)?,
+        ladd: match scenario.coupling.method {
+            CouplingMethod::Psm => None,
+            CouplingMethod::Ladd => Some(LaddMap::new(grid, r)?),
         },
+        thickness: scenario.grains.thickness,
     };
     let mut c = Coupled::new(fluid, dem, map);
     c.solid.refresh_forces();
@@ -488,6 +503,8 @@ fn run_typed<T: Real>(
         wall_time_s,
         particles: grains,
         energy_budget_error: f64::NAN,
+        // The grains' budget; what the liquid took is in the DEM's external work.
+        energy: c.solid.energy().budget(&e0),
     });
     let sound = u.dx / (3f64.sqrt() * dt);
     let t_a = 2.0 * scenario.column.box_length.max(f.depth) / sound;

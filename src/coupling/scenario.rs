@@ -74,13 +74,16 @@ pub struct LiquidSpec {
     pub depth: f64,
 }
 
-/// How grains and fluid exchange momentum. An enum so further methods (Ladd's modified
-/// bounce-back, seed eq. 5.45–5.49) add a variant.
+/// How grains and fluid exchange momentum.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum CouplingMethod {
     /// Partially saturated cells (Noble & Torczynski 1998, seed eq. 5.50–5.54).
     Psm,
+    /// Ladd's modified bounce-back on the links into the grains (seed eq. 5.45–5.49), with
+    /// the momentum of covered and uncovered nodes handed to the grain
+    /// ([`crate::coupling::LaddMap`]).
+    Ladd,
 }
 
 /// Coupling and lattice parameters.

@@ -629,6 +629,16 @@ impl Mpm {
     // The stencil loops index several 3-arrays (weights, gradients, offsets) by node.
     #[allow(clippy::needless_range_loop)]
     fn p2g(&mut self, mass: bool, force: bool, momentum: bool) {
+        // The transfer is a const parameter so the FLIP path carries no APIC branches.
+        if self.transfer == Transfer::Apic && (mass || momentum) {
+            self.p2g_with::<true>(mass, force, momentum)
+        } else {
+            self.p2g_with::<false>(mass, force, momentum)
+        }
+    }
+
+    #[allow(clippy::needless_range_loop)]
+    fn p2g_with<const APIC: bool>(&mut self, mass: bool, force: bool, momentum: bool) {
         let g = &mut self.grid;
         let nny = g.ny + 1;
         let pts = &self.points;
@@ -636,7 +646,7 @@ impl Mpm {
         let (order, starts) = (&self.order, &self.stripe_start);
         let stencils = &self.stencils;
         let ns = starts.len() - 1;
-        let apic = self.transfer == Transfer::Apic && (mass || momentum);
+        let apic = APIC;
         let (origin, h) = (g.origin, g.h);
         g.sums.par_iter_mut().for_each(|s| {
             if mass {
@@ -781,6 +791,15 @@ impl Mpm {
 
     /// One loop over the points (parallel in chunks), see [`PointPass`].
     fn point_pass(&mut self, pass: PointPass) -> Result<()> {
+        // The transfer is a const parameter so the FLIP path carries no APIC branches.
+        if self.transfer == Transfer::Apic {
+            self.point_pass_with::<true>(pass)
+        } else {
+            self.point_pass_with::<false>(pass)
+        }
+    }
+
+    fn point_pass_with<const APIC: bool>(&mut self, pass: PointPass) -> Result<()> {
         let g = &self.grid;
         let (h, origin, nny) = (g.h, g.origin, g.ny + 1);
         let (vold, vnew) = (&g.vel, &g.vel_new);
@@ -790,7 +809,7 @@ impl Mpm {
         };
         let dt = self.dt;
         let pic = self.params.pic_fraction;
-        let apic = self.transfer == Transfer::Apic;
+        let apic = APIC;
         let mat = &self.material;
         let do_v = matches!(
             pass,

@@ -65,17 +65,18 @@ pub fn column(n: usize, shape: ShapeKind) -> Result<Mpm> {
         },
     ];
     let grid = Grid::new(nx, ny, h, [-2.0 * h, -2.0 * h], walls);
-    let material = MaterialModel::MohrCoulomb(MohrCoulomb {
-        elastic: LinearElastic {
-            density: 1925.0,
-            youngs_modulus: 1.98e6,
-            poisson_ratio: 0.23,
-        },
-        friction_angle: 22.2f64.to_radians(),
-        dilatancy_angle: 0.0,
-        cohesion: 0.0,
-        tension_cutoff: 0.0,
-    });
+    let elastic = LinearElastic {
+        density: 1925.0,
+        youngs_modulus: 1.98e6,
+        poisson_ratio: 0.23,
+    };
+    let material = MaterialModel::MohrCoulomb(MohrCoulomb::new(
+        elastic,
+        22.2f64.to_radians(),
+        0.0,
+        0.0,
+        0.0,
+    ));
     let mut pts = Points::default();
     pts.fill_rect([0.0, 0.0], [w as f64 * h, 2.0 * w as f64 * h], h, 2, 1925.0);
     let params = MpmParams {

@@ -224,13 +224,13 @@ impl MaterialSpec {
                 }
                 non_negative("material.cohesion", cohesion)?;
                 non_negative("material.tension_cutoff", tension_cutoff)?;
-                MaterialModel::MohrCoulomb(MohrCoulomb {
-                    elastic: el,
-                    friction_angle: friction_angle_deg.to_radians(),
-                    dilatancy_angle: dilatancy_angle_deg.to_radians(),
+                MaterialModel::MohrCoulomb(MohrCoulomb::new(
+                    el,
+                    friction_angle_deg.to_radians(),
+                    dilatancy_angle_deg.to_radians(),
                     cohesion,
                     tension_cutoff,
-                })
+                ))
             }
         })
     }

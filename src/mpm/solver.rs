@@ -628,6 +628,7 @@ impl Mpm {
     /// gravity force; `momentum`: momentum only (MUSL re-map; mass kept).
     // The stencil loops index several 3-arrays (weights, gradients, offsets) by node.
     #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
     fn p2g(&mut self, mass: bool, force: bool, momentum: bool) {
         // The transfer is a const parameter so the FLIP path carries no APIC branches.
         if self.transfer == Transfer::Apic && (mass || momentum) {
@@ -638,6 +639,7 @@ impl Mpm {
     }
 
     #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
     fn p2g_with<const APIC: bool>(&mut self, mass: bool, force: bool, momentum: bool) {
         let g = &mut self.grid;
         let nny = g.ny + 1;
@@ -790,6 +792,7 @@ impl Mpm {
     }
 
     /// One loop over the points (parallel in chunks), see [`PointPass`].
+    #[inline(always)]
     fn point_pass(&mut self, pass: PointPass) -> Result<()> {
         // The transfer is a const parameter so the FLIP path carries no APIC branches.
         if self.transfer == Transfer::Apic {
@@ -799,6 +802,7 @@ impl Mpm {
         }
     }
 
+    #[inline(always)]
     fn point_pass_with<const APIC: bool>(&mut self, pass: PointPass) -> Result<()> {
         let g = &self.grid;
         let (h, origin, nny) = (g.h, g.origin, g.ny + 1);

@@ -179,7 +179,7 @@ pub fn selfweight(fidelity: Fidelity) -> Result<Vec<Check>> {
 fn biaxial(m: &MohrCoulomb, sigma3: f64, de: f64, n: usize) -> (f64, f64, f64) {
     let mut s = [-sigma3, -sigma3, 0.0, -sigma3];
     let mut state = MaterialState::default();
-    let d = m.elastic.lambda() + 2.0 * m.elastic.shear_modulus();
+    let d = m.elastic().lambda() + 2.0 * m.elastic().shear_modulus();
     let (mut peak, mut ev, mut ey) = (0.0f64, 0.0, 0.0);
     let mut exx = 0.0;
     for _ in 0..n {
@@ -340,13 +340,11 @@ pub fn mc_biaxial(fidelity: Fidelity) -> Result<Vec<Check>> {
     let case = "mpm-mc-biaxial";
     let sigma3 = 1e5;
     let mut out = Vec::new();
-    let make = |phi: f64, psi: f64, c: f64| MohrCoulomb {
-        elastic: elastic(2000.0, 2e7, 0.3),
-        friction_angle: phi.to_radians(),
-        dilatancy_angle: psi.to_radians(),
-        cohesion: c,
-        tension_cutoff: 0.0,
+    let with = |e: f64, phi: f64, psi: f64, c: f64| {
+        let el = elastic(2000.0, e, 0.3);
+        MohrCoulomb::new(el, phi.to_radians(), psi.to_radians(), c, 0.0)
     };
+    let make = |phi: f64, psi: f64, c: f64| with(2e7, phi, psi, c);
     for phi in [20.0f64, 30.0, 40.0] {
         for c in [0.0, 1e4] {
             let m = make(phi, 0.0, c);
@@ -385,10 +383,7 @@ pub fn mc_biaxial(fidelity: Fidelity) -> Result<Vec<Check>> {
         Fidelity::Test => 6000,
         Fidelity::Full => 24000,
     };
-    let stiff = |phi: f64, psi: f64, c: f64| MohrCoulomb {
-        elastic: elastic(2000.0, 1e8, 0.3),
-        ..make(phi, psi, c)
-    };
+    let stiff = |phi: f64, psi: f64, c: f64| with(1e8, phi, psi, c);
     for phi in [20.0f64, 30.0, 40.0] {
         for c in [0.0, 1e4] {
             let sp = phi.to_radians().sin();
@@ -791,13 +786,13 @@ pub fn conservation(fidelity: Fidelity) -> Result<Vec<Check>> {
         (Scheme::Musl, 0.05),
     ] {
         let h = 0.02;
-        let mat = MaterialModel::MohrCoulomb(MohrCoulomb {
-            elastic: elastic(1800.0, 1e6, 0.25),
-            friction_angle: 30f64.to_radians(),
-            dilatancy_angle: 5f64.to_radians(),
-            cohesion: 100.0,
-            tension_cutoff: 50.0,
-        });
+        let mat = MaterialModel::MohrCoulomb(MohrCoulomb::new(
+            elastic(1800.0, 1e6, 0.25),
+            30f64.to_radians(),
+            5f64.to_radians(),
+            100.0,
+            50.0,
+        ));
         let mut mpm = block(
             0.2,
             0.1,

@@ -32,7 +32,11 @@ impl LinearElastic {
     /// The elastic trial stress: Jaumann rotation plus Hooke's increment.
     #[inline(always)]
     pub fn trial(&self, stress: &Stress, de: &Strain, spin: f64) -> Stress {
-        let (l, g2) = (self.lambda(), 2.0 * self.shear_modulus());
+        Self::trial_with(self.lambda(), 2.0 * self.shear_modulus(), stress, de, spin)
+    }
+    /// [`Self::trial`] with λ and 2G given (precomputed by the caller).
+    #[inline(always)]
+    pub fn trial_with(l: f64, g2: f64, stress: &Stress, de: &Strain, spin: f64) -> Stress {
         let tr = de[0] + de[1];
         let s = jaumann(stress, spin);
         [

@@ -26,19 +26,42 @@
 use super::elastic::LinearElastic;
 use super::{Material, MaterialState, Strain, Stress};
 
-/// Mohr–Coulomb parameters.
+/// Mohr–Coulomb parameters, with the constants of the return mapping (k, m, σ_c, apex, λ,
+/// 2G) derived once in [`MohrCoulomb::new`] rather than per call (they need sin/cos of the
+/// angles, which otherwise cost a third of the update).
 #[derive(Clone, Copy, Debug)]
 pub struct MohrCoulomb {
-    /// Elastic part.
-    pub elastic: LinearElastic,
-    /// Friction angle φ (rad), 0 < φ < π/2.
-    pub friction_angle: f64,
-    /// Dilatancy angle ψ (rad), 0 ≤ ψ ≤ φ.
-    pub dilatancy_angle: f64,
-    /// Cohesion c (Pa), ≥ 0.
-    pub cohesion: f64,
-    /// Tension cut-off σ_t (Pa), ≥ 0; values above the apex stress c cot φ act as the apex.
-    pub tension_cutoff: f64,
+    elastic: LinearElastic,
+    friction_angle: f64,
+    dilatancy_angle: f64,
+    cohesion: f64,
+    tension_cutoff: f64,
+    derived: Derived,
+}
+
+/// Constants derived from the parameters (see the module doc for the formulas).
+#[derive(Clone, Copy, Debug)]
+struct Derived {
+    k: f64,
+    m: f64,
+    sigma_c: f64,
+    apex: f64,
+    lambda: f64,
+    two_g: f64,
+    /// (1 + ν)/E and ν/E: ε = (1 + ν)/E σ − ν/E tr σ (plane strain, principal components).
+    compliance: f64,
+    poisson_compliance: f64,
+    /// D b for the plane return and 1/(a·D b).
+    db: P3,
+    inv_adb: f64,
+    /// Edge returns: n = D b₁ × D b₂ and 1/(n·r) for the edges σ₁ = σ₂ (extension) and σ₂ = σ₃
+    /// (compression).
+    n_ext: P3,
+    inv_nr_ext: f64,
+    n_comp: P3,
+    inv_nr_comp: f64,
+    /// The effective tension cut-off min(σ_t, apex).
+    cutoff: f64,
 }
 
 type P3 = [f64; 3];
@@ -73,24 +96,90 @@ pub enum Return {
 }
 
 impl MohrCoulomb {
+    /// Mohr–Coulomb material: friction angle φ (rad, 0 < φ < π/2), dilatancy angle ψ (rad,
+    /// 0 ≤ ψ ≤ φ), cohesion c (Pa, ≥ 0) and tension cut-off σ_t (Pa, ≥ 0; values above the
+    /// apex stress c cot φ act as the apex). The scenario checks the ranges.
+    pub fn new(
+        elastic: LinearElastic,
+        friction_angle: f64,
+        dilatancy_angle: f64,
+        cohesion: f64,
+        tension_cutoff: f64,
+    ) -> Self {
+        let (sp, cp) = friction_angle.sin_cos();
+        let sd = dilatancy_angle.sin();
+        let k = (1.0 + sp) / (1.0 - sp);
+        let m = (1.0 + sd) / (1.0 - sd);
+        let sigma_c = 2.0 * cohesion * cp / (1.0 - sp);
+        let apex = sigma_c / (k - 1.0);
+        let (lambda, two_g) = (elastic.lambda(), 2.0 * elastic.shear_modulus());
+        let d = |v: P3| {
+            let s = lambda * (v[0] + v[1] + v[2]);
+            [s + two_g * v[0], s + two_g * v[1], s + two_g * v[2]]
+        };
+        let db = d([m, 0.0, -1.0]);
+        let n_ext = cross(&db, &d([0.0, m, -1.0]));
+        let n_comp = cross(&db, &d([m, -1.0, 0.0]));
+        MohrCoulomb {
+            elastic,
+            friction_angle,
+            dilatancy_angle,
+            cohesion,
+            tension_cutoff,
+            derived: Derived {
+                k,
+                m,
+                sigma_c,
+                apex,
+                lambda,
+                two_g,
+                compliance: (1.0 + elastic.poisson_ratio) / elastic.youngs_modulus,
+                poisson_compliance: elastic.poisson_ratio / elastic.youngs_modulus,
+                db,
+                inv_adb: 1.0 / dot(&[k, 0.0, -1.0], &db),
+                n_ext,
+                inv_nr_ext: 1.0 / dot(&n_ext, &[1.0, 1.0, k]),
+                n_comp,
+                inv_nr_comp: 1.0 / dot(&n_comp, &[1.0, k, k]),
+                cutoff: tension_cutoff.min(apex),
+            },
+        }
+    }
+    /// The elastic part.
+    pub fn elastic(&self) -> &LinearElastic {
+        &self.elastic
+    }
+    /// Friction angle φ (rad).
+    pub fn friction_angle(&self) -> f64 {
+        self.friction_angle
+    }
+    /// Dilatancy angle ψ (rad).
+    pub fn dilatancy_angle(&self) -> f64 {
+        self.dilatancy_angle
+    }
+    /// Cohesion c (Pa).
+    pub fn cohesion(&self) -> f64 {
+        self.cohesion
+    }
+    /// Tension cut-off σ_t (Pa).
+    pub fn tension_cutoff(&self) -> f64 {
+        self.tension_cutoff
+    }
     /// k = (1 + sin φ)/(1 − sin φ).
     pub fn k(&self) -> f64 {
-        let s = self.friction_angle.sin();
-        (1.0 + s) / (1.0 - s)
+        self.derived.k
     }
     /// m = (1 + sin ψ)/(1 − sin ψ).
     pub fn m(&self) -> f64 {
-        let s = self.dilatancy_angle.sin();
-        (1.0 + s) / (1.0 - s)
+        self.derived.m
     }
     /// σ_c = 2c cos φ/(1 − sin φ).
     pub fn sigma_c(&self) -> f64 {
-        let p = self.friction_angle;
-        2.0 * self.cohesion * p.cos() / (1.0 - p.sin())
+        self.derived.sigma_c
     }
     /// Apex stress σ_c/(k − 1) = c cot φ.
     pub fn apex(&self) -> f64 {
-        self.sigma_c() / (self.k() - 1.0)
+        self.derived.apex
     }
     /// f(σ) = k σ₁ − σ₃ − σ_c for sorted principal stresses.
     pub fn yield_function(&self, p: &P3) -> f64 {
@@ -98,16 +187,17 @@ impl MohrCoulomb {
     }
 
     /// D·v in principal space: λ (Σv) (1,1,1) + 2G v.
-    #[inline(always)]
+    #[cfg(test)]
     fn d(&self, v: &P3) -> P3 {
-        let (l, g2) = (self.elastic.lambda(), 2.0 * self.elastic.shear_modulus());
+        let (l, g2) = (self.derived.lambda, self.derived.two_g);
         let s = l * (v[0] + v[1] + v[2]);
         [s + g2 * v[0], s + g2 * v[1], s + g2 * v[2]]
     }
 
     /// Return a sorted principal trial stress σ_B (σ₁ ≥ σ₂ ≥ σ₃) to the admissible set.
     pub fn return_principal(&self, sb: &P3) -> (P3, Return) {
-        let (k, m, sc) = (self.k(), self.m(), self.sigma_c());
+        let dv = &self.derived;
+        let (k, sc) = (dv.k, dv.sigma_c);
         let scale = sb
             .iter()
             .fold(self.elastic.youngs_modulus * 1e-12, |a, v| a.max(v.abs()));
@@ -115,52 +205,43 @@ impl MohrCoulomb {
         let (mut s, mut kind) = if f <= 1e-14 * scale {
             (*sb, Return::Elastic)
         } else {
-            let b = [m, 0.0, -1.0];
-            let db = self.d(&b);
-            let dl = f / dot(&[k, 0.0, -1.0], &db);
+            let db = dv.db;
+            let dl = f * dv.inv_adb;
             let c = [sb[0] - dl * db[0], sb[1] - dl * db[1], sb[2] - dl * db[2]];
             let tol = 1e-12 * scale;
-            let apex = self.apex();
-            let line = |r: P3, b2: P3| -> (P3, bool) {
-                let n = cross(&db, &self.d(&b2));
-                let t = dot(&n, &[sb[0] - apex, sb[1] - apex, sb[2] - apex]) / dot(&n, &r);
+            let apex = dv.apex;
+            // Edge return: σ = σ_apex + t r, t = n·(σ_B − σ_apex)/(n·r); past the apex if t > 0.
+            let line = |r: P3, n: &P3, inv_nr: f64, edge: Return| -> (P3, Return) {
+                let t = dot(n, &[sb[0] - apex, sb[1] - apex, sb[2] - apex]) * inv_nr;
                 if t > 0.0 {
-                    ([apex; 3], true)
+                    ([apex; 3], Return::Apex)
                 } else {
-                    ([apex + t * r[0], apex + t * r[1], apex + t * r[2]], false)
+                    ([apex + t * r[0], apex + t * r[1], apex + t * r[2]], edge)
                 }
             };
             if c[1] > c[0] + tol {
-                let (s, at_apex) = line([1.0, 1.0, k], [0.0, m, -1.0]);
-                (
-                    s,
-                    if at_apex {
-                        Return::Apex
-                    } else {
-                        Return::EdgeExtension
-                    },
+                line(
+                    [1.0, 1.0, k],
+                    &dv.n_ext,
+                    dv.inv_nr_ext,
+                    Return::EdgeExtension,
                 )
             } else if c[2] > c[1] + tol {
-                let (s, at_apex) = line([1.0, k, k], [m, -1.0, 0.0]);
-                (
-                    s,
-                    if at_apex {
-                        Return::Apex
-                    } else {
-                        Return::EdgeCompression
-                    },
+                line(
+                    [1.0, k, k],
+                    &dv.n_comp,
+                    dv.inv_nr_comp,
+                    Return::EdgeCompression,
                 )
             } else {
                 (c, Return::Plane)
             }
         };
         // Tension cut-off (Rankine) on whatever principal stresses exceed σ_t.
-        let st = self.tension_cutoff.min(self.apex());
+        let st = self.derived.cutoff;
         if s[0] > st {
-            let (l, lg) = (
-                self.elastic.lambda(),
-                self.elastic.lambda() + 2.0 * self.elastic.shear_modulus(),
-            );
+            let l = self.derived.lambda;
+            let lg = l + self.derived.two_g;
             let n_over = s.iter().filter(|&&v| v > st).count();
             match n_over {
                 1 => {
@@ -192,48 +273,49 @@ impl MohrCoulomb {
         spin: f64,
         state: &mut MaterialState,
     ) -> (Stress, Return) {
-        let t = self.elastic.trial(stress, de, spin);
+        let t =
+            LinearElastic::trial_with(self.derived.lambda, self.derived.two_g, stress, de, spin);
         // In-plane principal stresses and direction.
         let p = 0.5 * (t[0] + t[1]);
         let q = 0.5 * (t[0] - t[1]);
         let r = (q * q + t[2] * t[2]).sqrt();
-        let (c2, s2) = if r > 0.0 {
-            (q / r, t[2] / r)
+        let (s1, s2, sz) = (p + r, p - r, t[3]);
+        // Sorted descending (s1 ≥ s2 always); `zslot` is where σ_zz went.
+        let (sb, zslot) = if sz > s1 {
+            ([sz, s1, s2], 0)
+        } else if sz > s2 {
+            ([s1, sz, s2], 1)
         } else {
-            (1.0, 0.0)
+            ([s1, s2, sz], 2)
         };
-        let vals = [p + r, p - r, t[3]];
-        // Sort descending, remembering the slot of each.
-        let mut idx = [0usize, 1, 2];
-        if vals[idx[0]] < vals[idx[1]] {
-            idx.swap(0, 1);
-        }
-        if vals[idx[1]] < vals[idx[2]] {
-            idx.swap(1, 2);
-        }
-        if vals[idx[0]] < vals[idx[1]] {
-            idx.swap(0, 1);
-        }
-        let sb = [vals[idx[0]], vals[idx[1]], vals[idx[2]]];
         let (sr, kind) = self.return_principal(&sb);
         if kind == Return::Elastic {
             state.yielding = false;
             return (t, kind);
         }
         // Plastic strain increment C⁻¹ (σ_B − σ) in principal space.
-        let (e, nu) = (self.elastic.youngs_modulus, self.elastic.poisson_ratio);
+        let (a, b) = (self.derived.compliance, self.derived.poisson_compliance);
         let ds = [sb[0] - sr[0], sb[1] - sr[1], sb[2] - sr[2]];
         let tr = ds[0] + ds[1] + ds[2];
-        let ep = ds.map(|v| ((1.0 + nu) * v - nu * tr) / e);
+        let ep = ds.map(|v| a * v - b * tr);
         let ev = ep[0] + ep[1] + ep[2];
-        let dev = ep.map(|v| v - ev / 3.0);
+        let dev = ep.map(|v| v - ev * (1.0 / 3.0));
         state.plastic_strain += (2.0 / 3.0 * dot(&dev, &dev)).sqrt();
         state.plastic_volumetric += ev;
         state.yielding = true;
-        let mut out = [0.0; 3];
-        for k in 0..3 {
-            out[idx[k]] = sr[k];
-        }
+        // Returned in-plane principal values and σ_zz, undoing the sort.
+        let out = match zslot {
+            0 => [sr[1], sr[2], sr[0]],
+            1 => [sr[0], sr[2], sr[1]],
+            _ => sr,
+        };
+        // Back to x–y along the trial's principal directions: cos 2θ = q/r, sin 2θ = σ_xy/r.
+        let (c2, s2) = if r > 0.0 {
+            let inv = 1.0 / r;
+            (q * inv, t[2] * inv)
+        } else {
+            (1.0, 0.0)
+        };
         let (pa, pb) = (0.5 * (out[0] + out[1]), 0.5 * (out[0] - out[1]));
         ([pa + pb * c2, pa - pb * c2, pb * s2, out[2]], kind)
     }
@@ -266,17 +348,12 @@ mod tests {
     use super::*;
 
     fn mc(phi: f64, psi: f64, c: f64, st: f64) -> MohrCoulomb {
-        MohrCoulomb {
-            elastic: LinearElastic {
-                density: 2000.0,
-                youngs_modulus: 2e7,
-                poisson_ratio: 0.3,
-            },
-            friction_angle: phi.to_radians(),
-            dilatancy_angle: psi.to_radians(),
-            cohesion: c,
-            tension_cutoff: st,
-        }
+        let elastic = LinearElastic {
+            density: 2000.0,
+            youngs_modulus: 2e7,
+            poisson_ratio: 0.3,
+        };
+        MohrCoulomb::new(elastic, phi.to_radians(), psi.to_radians(), c, st)
     }
 
     /// A small deterministic generator of sorted principal trial stresses over all regions.

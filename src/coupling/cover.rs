@@ -23,6 +23,8 @@ use crate::lbm::{CellForces, SolidCover};
 
 /// Grains per parallel chunk of the rasterisation.
 const GRAIN_CHUNK: usize = 64;
+/// Lattice rows per band of the parallel per-cell pass.
+const BAND_ROWS: usize = 32;
 
 /// The lattice the disks are drawn on.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,20 +53,27 @@ struct Piece {
 ///
 /// Per-cell sums live in dense arrays over the lattice (reset cell by cell after use), so a
 /// step allocates nothing once the buffers have grown and needs no sort of the pieces.
+///
+/// Everything runs in parallel without locks: the overlaps are computed per chunk of
+/// [`GRAIN_CHUNK`] grains and filed by band of [`BAND_ROWS`] lattice rows
+/// (`pieces[chunk × bands + band]`); the per-cell sums then run per band (a band owns its
+/// cells), and the force sums per chunk (a chunk owns its grains). Within a cell the pieces
+/// are summed in grain order, and within a grain in band order, whatever the thread count.
 #[derive(Clone, Debug)]
 pub struct DiskCover {
     /// The lattice.
     pub grid: Grid,
     /// Hydrodynamic radius factor κ = r/R ∈ (0, 1].
     pub radius_factor: f64,
-    /// Overlaps of each chunk of [`GRAIN_CHUNK`] grains.
+    /// Overlaps of each chunk of [`GRAIN_CHUNK`] grains in each band of [`BAND_ROWS`] rows,
+    /// at `chunk × bands + band`.
     pieces: Vec<Vec<Piece>>,
+    /// Cells each band touched in the last cover (ascending).
+    band_cells: Vec<Vec<u32>>,
     /// Σ_k ε_nk, Σ_k ε_nk u_x, Σ_k ε_nk u_y per cell (dense; zero outside the cover).
     acc: Vec<[f64; 3]>,
     /// Cover slot of each cell (dense; valid for covered cells).
     slot_of: Vec<u32>,
-    /// Cells touched by the last cover.
-    touched: Vec<u32>,
     /// Σ_k ε_nk per cover slot (unclipped).
     total: Vec<f64>,
     /// Grains seen by the last cover.
@@ -85,9 +94,9 @@ impl DiskCover {
             grid,
             radius_factor,
             pieces: Vec::new(),
+            band_cells: vec![Vec::new(); grid.ny.div_ceil(BAND_ROWS)],
             acc: vec![[0.0; 3]; n],
             slot_of: vec![u32::MAX; n],
-            touched: Vec::new(),
             total: Vec::new(),
             grains: 0,
         })
@@ -101,20 +110,19 @@ impl DiskCover {
             dx,
             periodic,
         } = self.grid;
-        self.touched.clear();
         self.grains = g.x.len();
-        // Overlaps in parallel over chunks of grains (one reused buffer per chunk), then summed
-        // per cell in one serial pass (grains may share cells).
         let chunks = g.x.len().div_ceil(GRAIN_CHUNK);
-        if self.pieces.len() < chunks {
-            self.pieces.resize_with(chunks, Vec::new);
+        let bands = self.band_cells.len();
+        if self.pieces.len() < chunks * bands {
+            self.pieces.resize_with(chunks * bands, Vec::new);
         }
+        // Overlaps in parallel over chunks of grains, filed by band.
         let kappa = self.radius_factor;
-        self.pieces[..chunks]
-            .par_iter_mut()
+        self.pieces[..chunks * bands]
+            .par_chunks_mut(bands)
             .enumerate()
-            .for_each(|(ch, buf)| {
-                buf.clear();
+            .for_each(|(ch, bufs)| {
+                bufs.iter_mut().for_each(Vec::clear);
                 let k1 = ((ch + 1) * GRAIN_CHUNK).min(g.x.len());
                 for k in ch * GRAIN_CHUNK..k1 {
                     let r = kappa * g.radius[k] / dx;
@@ -125,6 +133,7 @@ impl DiskCover {
                         let Some(jj) = wrap(j, ny, periodic[1]) else {
                             continue;
                         };
+                        let buf = &mut bufs[jj / BAND_ROWS];
                         for i in i0..=i1 {
                             let Some(ii) = wrap(i, nx, periodic[0]) else {
                                 continue;
@@ -143,43 +152,87 @@ impl DiskCover {
                     }
                 }
             });
-        for p in self.pieces[..chunks].iter().flatten() {
-            let k = p.grain as usize;
-            let w = g.omega[k];
-            let a = &mut self.acc[p.cell as usize];
-            if a[0] == 0.0 {
-                self.touched.push(p.cell);
-            }
-            a[0] += p.eps;
-            a[1] += p.eps * (g.vx[k] - w * p.r[1]);
-            a[2] += p.eps * (g.vy[k] + w * p.r[0]);
-        }
-        out.cells.clear();
-        out.eps.clear();
-        out.ux.clear();
-        out.uy.clear();
-        self.total.clear();
-        // Ascending order: sort the touched cells, or scan the lattice when they are many.
-        if self.touched.len() * 16 > self.acc.len() {
-            self.touched.clear();
-            for (c, a) in self.acc.iter().enumerate() {
-                if a[0] > 0.0 {
-                    self.touched.push(c as u32);
+        // Per band: sum the pieces per cell (grains may share cells), list the touched cells
+        // in ascending order (sorted, or by a scan of the band when they are many).
+        let band_len = BAND_ROWS * nx;
+        let pieces = &self.pieces;
+        self.acc
+            .par_chunks_mut(band_len)
+            .zip(self.band_cells.par_iter_mut())
+            .enumerate()
+            .for_each(|(b, (acc, touched))| {
+                touched.clear();
+                let c0 = b * band_len;
+                for ch in 0..chunks {
+                    for p in &pieces[ch * bands + b] {
+                        let k = p.grain as usize;
+                        let w = g.omega[k];
+                        let a = &mut acc[p.cell as usize - c0];
+                        if a[0] == 0.0 {
+                            touched.push(p.cell);
+                        }
+                        a[0] += p.eps;
+                        a[1] += p.eps * (g.vx[k] - w * p.r[1]);
+                        a[2] += p.eps * (g.vy[k] + w * p.r[0]);
+                    }
                 }
-            }
-        } else {
-            self.touched.sort_unstable();
+                if touched.len() * 16 > acc.len() {
+                    touched.clear();
+                    touched.extend(
+                        (0..acc.len())
+                            .filter(|&c| acc[c][0] > 0.0)
+                            .map(|c| (c0 + c) as u32),
+                    );
+                } else {
+                    touched.sort_unstable();
+                }
+            });
+        // Output: each band fills its slice of the cover (offsets from the band counts).
+        let total: usize = self.band_cells.iter().map(Vec::len).sum();
+        out.cells.resize(total, 0);
+        out.eps.resize(total, 0.0);
+        out.ux.resize(total, 0.0);
+        out.uy.resize(total, 0.0);
+        self.total.resize(total, 0.0);
+        let mut slices = Vec::with_capacity(bands);
+        let (mut cells, mut eps, mut ux, mut uy, mut tot) = (
+            &mut out.cells[..],
+            &mut out.eps[..],
+            &mut out.ux[..],
+            &mut out.uy[..],
+            &mut self.total[..],
+        );
+        let mut offset = 0;
+        for t in &self.band_cells {
+            let n = t.len();
+            let (c, rc) = std::mem::take(&mut cells).split_at_mut(n);
+            let (e, re) = std::mem::take(&mut eps).split_at_mut(n);
+            let (x, rx) = std::mem::take(&mut ux).split_at_mut(n);
+            let (y, ry) = std::mem::take(&mut uy).split_at_mut(n);
+            let (s, rs) = std::mem::take(&mut tot).split_at_mut(n);
+            slices.push((offset, c, e, x, y, s));
+            (cells, eps, ux, uy, tot) = (rc, re, rx, ry, rs);
+            offset += n;
         }
-        for &c in &self.touched {
-            let a = &mut self.acc[c as usize];
-            self.slot_of[c as usize] = out.cells.len() as u32;
-            out.cells.push(c);
-            out.eps.push(a[0].min(1.0));
-            out.ux.push(a[1] / a[0]);
-            out.uy.push(a[2] / a[0]);
-            self.total.push(a[0]);
-            *a = [0.0; 3];
-        }
+        self.acc
+            .par_chunks_mut(band_len)
+            .zip(self.slot_of.par_chunks_mut(band_len))
+            .zip(self.band_cells.par_iter())
+            .zip(slices.into_par_iter())
+            .enumerate()
+            .for_each(|(b, (((acc, slot_of), touched), (off, c, e, x, y, s)))| {
+                let c0 = b * band_len;
+                for (k, &cell) in touched.iter().enumerate() {
+                    let a = &mut acc[cell as usize - c0];
+                    slot_of[cell as usize - c0] = (off + k) as u32;
+                    c[k] = cell;
+                    e[k] = a[0].min(1.0);
+                    x[k] = a[1] / a[0];
+                    y[k] = a[2] / a[0];
+                    s[k] = a[0];
+                    *a = [0.0; 3];
+                }
+            });
     }
 
     /// Number of grains the last [`DiskCover::cover`] saw.
@@ -198,16 +251,28 @@ impl DiskCover {
             // The fluid has not stepped with this cover yet: no force.
             return;
         }
+        // Per chunk of grains (a chunk owns its grains and their pieces).
+        let bands = self.band_cells.len();
         let chunks = self.grains.div_ceil(GRAIN_CHUNK);
-        for p in self.pieces[..chunks].iter().flatten() {
-            let s = self.slot_of[p.cell as usize] as usize;
-            let share = p.eps / self.total[s];
-            let (fx, fy) = (share * forces.fx[s], share * forces.fy[s]);
-            let k = p.grain as usize;
-            loads.fx[k] += fx;
-            loads.fy[k] += fy;
-            loads.torque[k] += p.r[0] * fy - p.r[1] * fx;
-        }
+        let (slot_of, total) = (&self.slot_of, &self.total);
+        self.pieces[..chunks * bands]
+            .par_chunks(bands)
+            .zip(loads.fx.par_chunks_mut(GRAIN_CHUNK))
+            .zip(loads.fy.par_chunks_mut(GRAIN_CHUNK))
+            .zip(loads.torque.par_chunks_mut(GRAIN_CHUNK))
+            .enumerate()
+            .for_each(|(ch, (((bufs, lx), ly), lt))| {
+                let k0 = ch * GRAIN_CHUNK;
+                for p in bufs.iter().flatten() {
+                    let s = slot_of[p.cell as usize] as usize;
+                    let share = p.eps / total[s];
+                    let (fx, fy) = (share * forces.fx[s], share * forces.fy[s]);
+                    let k = p.grain as usize - k0;
+                    lx[k] += fx;
+                    ly[k] += fy;
+                    lt[k] += p.r[0] * fy - p.r[1] * fx;
+                }
+            });
     }
 }
 

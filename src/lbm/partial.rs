@@ -127,8 +127,9 @@ impl<T: Real> PartialCells<T> {
 
     /// Build `row_start` for a lattice of `nx × ny` cells; checks the order of `cells`.
     pub(crate) fn index_rows(&mut self, nx: usize, ny: usize) {
+        use rayon::prelude::*;
         assert!(
-            self.cells.windows(2).all(|w| w[0] < w[1]),
+            self.cells.par_windows(2).all(|w| w[0] < w[1]),
             "partial cells must be ascending and unique"
         );
         assert!(
@@ -139,13 +140,9 @@ impl<T: Real> PartialCells<T> {
         assert!(self.b.len() == n && self.ux.len() == n && self.uy.len() == n);
         self.exchange.resize(n, [0.0; 2]);
         self.row_start.clear();
-        let mut k = 0;
-        for y in 0..=ny {
-            while k < n && (self.cells[k] as usize) < y * nx {
-                k += 1;
-            }
-            self.row_start.push(k as u32);
-        }
+        let cells = &self.cells;
+        self.row_start
+            .extend((0..=ny).map(|y| cells.partition_point(|&c| (c as usize) < y * nx) as u32));
     }
 }
 

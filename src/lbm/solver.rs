@@ -137,19 +137,23 @@ impl<T: Real> Lbm<T> {
     /// [`partial::weighting`] with the molecular τ, velocities converted to lattice units.
     /// Cells must be ascending.
     pub fn set_cover(&mut self, cover: &SolidCover) {
+        use rayon::prelude::*;
         let p = &mut self.partial;
         p.clear();
-        let tau = self.collider.tau;
-        for k in 0..cover.cells.len() {
-            p.push(
-                cover.cells[k],
-                partial::weighting(cover.eps[k], tau),
-                [
-                    self.units.velocity_to_lattice(cover.ux[k]),
-                    self.units.velocity_to_lattice(cover.uy[k]),
-                ],
-            );
-        }
+        let (tau, units) = (self.collider.tau, &self.units);
+        p.cells.extend_from_slice(&cover.cells);
+        p.b.par_extend(
+            cover
+                .eps
+                .par_iter()
+                .map(|&e| T::c(partial::weighting(e, tau))),
+        );
+        let lattice_velocity = |v: &Vec<f64>, out: &mut Vec<T>| {
+            out.par_extend(v.par_iter().map(|&u| T::c(units.velocity_to_lattice(u))));
+        };
+        lattice_velocity(&cover.ux, &mut p.ux);
+        lattice_velocity(&cover.uy, &mut p.uy);
+        p.exchange.resize(cover.cells.len(), [0.0; 2]);
     }
 
     /// Total fluid momentum Σ_cells Σ_i f_i e_i (lattice units, pre-collision, without the
@@ -336,10 +340,13 @@ impl<T: Real> Scale for Lbm<T> {
         for _ in 0..k as u64 {
             self.step();
             let (sum, count) = &mut self.exchange_sum;
-            for (s, e) in sum.iter_mut().zip(&self.partial.exchange) {
-                s[0] += e[0];
-                s[1] += e[1];
-            }
+            use rayon::prelude::*;
+            sum.par_iter_mut()
+                .zip(self.partial.exchange.par_iter())
+                .for_each(|(s, e)| {
+                    s[0] += e[0];
+                    s[1] += e[1];
+                });
             *count += 1;
         }
         Ok(())
@@ -348,12 +355,14 @@ impl<T: Real> Scale for Lbm<T> {
     fn observe(&self, out: &mut CellForces) {
         let (sum, count) = &self.exchange_sum;
         let k = (*count).max(1) as f64;
+        use rayon::prelude::*;
+        let u = &self.units;
         out.fx.clear();
         out.fy.clear();
-        for s in sum {
-            out.fx.push(-self.units.force_to_si(s[0] / k));
-            out.fy.push(-self.units.force_to_si(s[1] / k));
-        }
+        out.fx
+            .par_extend(sum.par_iter().map(|s| -u.force_to_si(s[0] / k)));
+        out.fy
+            .par_extend(sum.par_iter().map(|s| -u.force_to_si(s[1] / k)));
         self.ladd.observe(&self.units, &mut out.links);
     }
     fn snapshot(&self) -> LbmSnapshot<T> {

@@ -4,6 +4,7 @@
 use std::path::Path;
 
 use granflow::mpm::scenario::MpmScenario;
+use granflow::mpm::Transfer;
 use granflow::validate::{run, Fidelity};
 
 fn case_passes(name: &str) {
@@ -97,6 +98,26 @@ fn bad_scenarios_are_refused_naming_the_field() {
     assert!(e.contains("time.dt"), "{e}");
     let s = MpmScenario::from_toml(&text.replace("[time]\n", "[time]\ndt = 1.0e-6\n")).unwrap();
     assert_eq!(s.build().unwrap().0.dt(), 1e-6);
+    // The velocity transfer: APIC is taken from the file, and refused with a PIC fraction or
+    // with standard shape functions, naming the field, before anything is built.
+    let apic = text.replace("transfer = \"flip\"", "transfer = \"apic\"");
+    let s = MpmScenario::from_toml(&apic.replace("pic_fraction = 0.005", "pic_fraction = 0.0"))
+        .unwrap();
+    assert_eq!(s.build().unwrap().0.transfer(), Transfer::Apic);
+    let e = MpmScenario::from_toml(&apic).unwrap().derive().unwrap_err();
+    assert!(e.to_string().contains("mpm.pic_fraction"), "{e}");
+    let std_apic = apic
+        .replace("pic_fraction = 0.005", "pic_fraction = 0.0")
+        .replace("shape = \"gimp\"", "shape = \"standard\"");
+    let e = MpmScenario::from_toml(&std_apic)
+        .unwrap()
+        .derive()
+        .unwrap_err();
+    assert!(e.to_string().contains("mpm.transfer"), "{e}");
+    let e = MpmScenario::from_toml(&text.replace("transfer = \"flip\"\n", ""))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("transfer"), "{e}");
 }
 
 /// A short stretch of the a = 2 collapse writes the DEM's summary keys, the time series and a

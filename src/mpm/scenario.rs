@@ -22,7 +22,7 @@ use super::grid::Grid;
 use super::material::{LinearElastic, MaterialModel, MohrCoulomb};
 use super::points::Points;
 use super::shape::ShapeKind;
-use super::solver::{cfl_step, Mpm, MpmParams, Scheme};
+use super::solver::{cfl_step, Mpm, MpmParams, Scheme, Transfer};
 use crate::config::{non_negative, positive};
 use crate::{Error, Result};
 
@@ -108,6 +108,9 @@ pub struct MpmSpec {
     pub courant: f64,
     /// Local damping α (0: none; a collapse should use 0).
     pub damping: f64,
+    /// Velocity transfer: `"flip"` (blended with PIC by `pic_fraction`) or `"apic"` (affine
+    /// PIC, Jiang et al. 2015; uGIMP only, `pic_fraction` must be 0).
+    pub transfer: Transfer,
     /// PIC fraction β of the velocity update (0: pure FLIP), see
     /// [`crate::mpm::MpmParams::pic_fraction`].
     pub pic_fraction: f64,
@@ -293,6 +296,7 @@ impl MpmScenario {
                 format!("must be in [0, 1), got {}", m.damping),
             ));
         }
+        m.transfer.check(m.shape, m.pic_fraction)?;
         let height = c.aspect_ratio * c.width;
         let h = m.cell_size;
         let (Some(wc), Some(hc)) = (whole(c.width / h), whole(height / h)) else {
@@ -380,7 +384,8 @@ impl MpmScenario {
             pic_fraction: self.mpm.pic_fraction,
             resort_every: self.mpm.resort_every,
         };
-        let mpm = Mpm::new(grid, pts, d.material, params)?;
+        let mut mpm = Mpm::new(grid, pts, d.material, params)?;
+        mpm.set_transfer(self.mpm.transfer)?;
         Ok((mpm, d))
     }
 }

@@ -161,6 +161,28 @@ pub enum Transfer {
     Apic,
 }
 
+impl Transfer {
+    /// Refuses APIC with standard MPM shape functions (D_p is singular on node lines) or with
+    /// a PIC fraction > 0 (APIC has none), naming the scenario field.
+    pub fn check(self, shape: ShapeKind, pic_fraction: f64) -> Result<()> {
+        if self == Transfer::Apic {
+            if shape != ShapeKind::Gimp {
+                return Err(Error::config(
+                    "mpm.transfer",
+                    "APIC needs uGIMP shape functions (with the hat D_p = 0 on node lines)",
+                ));
+            }
+            if pic_fraction != 0.0 {
+                return Err(Error::config(
+                    "mpm.pic_fraction",
+                    "must be 0 with the APIC transfer",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// A pressure load on one boundary face of a point's domain (see the module doc).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Traction {
@@ -343,20 +365,7 @@ impl Mpm {
     /// Choose the velocity transfer. APIC is refused with standard MPM shape functions (D_p is
     /// singular on node lines) or a PIC fraction > 0 (APIC has none), naming the field.
     pub fn set_transfer(&mut self, transfer: Transfer) -> Result<()> {
-        if transfer == Transfer::Apic {
-            if self.params.shape != ShapeKind::Gimp {
-                return Err(Error::config(
-                    "mpm.transfer",
-                    "APIC needs uGIMP shape functions (with the hat D_p = 0 on node lines)",
-                ));
-            }
-            if self.params.pic_fraction != 0.0 {
-                return Err(Error::config(
-                    "mpm.pic_fraction",
-                    "must be 0 with the APIC transfer",
-                ));
-            }
-        }
+        transfer.check(self.params.shape, self.params.pic_fraction)?;
         self.transfer = transfer;
         for b in self.points.affine.iter_mut() {
             *b = [0.0; 4];

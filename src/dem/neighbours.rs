@@ -29,26 +29,16 @@ pub struct PairList {
     pub j: Vec<u32>,
     /// Contact state of each pair: last overlap, springs, forces (see [`ContactState`]).
     pub state: Vec<ContactState>,
-    /// Forces of each pair applied in the last second half-kick: [F_x on i, F_y on i,
-    /// torque on i, torque on j] (the force on j is the opposite); valid where `flags` has
-    /// [`PAIR_ACTIVE`] (pairs apart before and after the step are skipped, `out` left stale).
-    pub out: Vec<[f64; 4]>,
-    /// Per pair: [`PAIR_ACTIVE`] if `out` holds this evaluation's force, [`PAIR_TOUCHING`] if
-    /// the grains overlapped at the last evaluation (the same as `state[p].touching()`, kept in
-    /// one byte so the force loop skips the many apart pairs without loading their state).
+    /// Per pair: [`PAIR_TOUCHING`] if the grains overlapped at the last evaluation (the same
+    /// as `state[p].touching()`, kept in one byte so the force loop skips the many apart pairs
+    /// without loading their state).
     pub flags: Vec<u8>,
     /// Pairs whose first grain is `g` are `first[g]..first[g + 1]`.
     pub first: Vec<u32>,
-    /// Pairs whose second grain is `g` are `as_j[j_start[g]..j_start[g + 1]]`.
-    pub j_start: Vec<u32>,
-    /// Pair indices grouped by second grain.
-    pub as_j: Vec<u32>,
 }
 
-/// [`PairList::flags`] bit: `out` holds this evaluation's force.
-pub const PAIR_ACTIVE: u8 = 1;
 /// [`PairList::flags`] bit: the grains overlapped at the last evaluation.
-pub const PAIR_TOUCHING: u8 = 2;
+pub const PAIR_TOUCHING: u8 = 1;
 
 /// Grain–wall pairs within reach, sorted by (grain, wall).
 #[derive(Clone, Debug, Default)]
@@ -59,8 +49,6 @@ pub struct WallList {
     pub wall: Vec<u32>,
     /// Contact state of each pair.
     pub state: Vec<ContactState>,
-    /// [F_x, F_y, torque] on the grain applied in the last second half-kick.
-    pub out: Vec<[f64; 3]>,
     /// Pairs of grain `g` are `first[g]..first[g + 1]`.
     pub first: Vec<u32>,
 }
@@ -254,8 +242,6 @@ impl Detector {
                 pl.state[p] = self.old_state[o];
             }
         }
-        pl.out.clear();
-        pl.out.resize(m, [0.0; 4]);
         pl.flags.clear();
         pl.flags.extend(
             pl.state
@@ -270,23 +256,6 @@ impl Detector {
         }
         for k in 0..n {
             pl.first[k + 1] += pl.first[k];
-        }
-        // Index by second grain (CSR).
-        pl.j_start.clear();
-        pl.j_start.resize(n + 1, 0);
-        for &j in &pl.j {
-            pl.j_start[j as usize + 1] += 1;
-        }
-        for k in 0..n {
-            pl.j_start[k + 1] += pl.j_start[k];
-        }
-        pl.as_j.clear();
-        pl.as_j.resize(m, 0);
-        let mut fill: Vec<u32> = pl.j_start[..n].to_vec();
-        for p in 0..m {
-            let j = pl.j[p] as usize;
-            pl.as_j[fill[j] as usize] = p as u32;
-            fill[j] += 1;
         }
     }
 
@@ -324,7 +293,5 @@ impl Detector {
             }
             wl.first[k + 1] = wl.grain.len() as u32;
         }
-        wl.out.clear();
-        wl.out.resize(wl.grain.len(), [0.0; 3]);
     }
 }

@@ -20,26 +20,28 @@
 //!    after the kick the force arrays are set to the true **F**_{k+1}, from which the next step
 //!    starts.
 //!
-//! Forces are computed per contact in parallel into per-pair slots and then gathered per
-//! grain in parallel (each grain sums its own pairs in a fixed order), so results do not
+//! Forces are computed in parallel over fixed chunks of grains, each chunk resolving the pairs
+//! whose first grain it holds and adding their forces straight to its grains; a force on a
+//! grain of a later chunk is queued and added by that chunk in the kick pass. Every grain's
+//! force is summed in an order fixed by the pair list and the chunk size, so results do not
 //! depend on the number of threads.
 //!
 //! Time step: seed eq. 5.59–5.60, Δt = λ Δt_cr with λ = 0.1 by default; see [`critical_step`].
 
 use rayon::prelude::*;
 
-use super::contact::{self, ContactOut, ContactParams, Event, Law, Motion};
+use super::contact::{self, ContactOut, ContactParams, ContactState, Event, Law, Motion};
 use super::detect_rapier::RapierDetector;
 use super::energy::Energy;
 use super::grains::Grains;
-use super::neighbours::{Detector, PairList, WallList, PAIR_ACTIVE, PAIR_TOUCHING};
+use super::neighbours::{Detector, PairList, WallList, PAIR_TOUCHING};
 use super::shape_contacts::{ShapeContacts, ShapeSums};
 use super::walls::Wall;
 use crate::{Error, Result};
 
-/// Pairs per parallel chunk of the force loop.
-const PAIR_CHUNK: usize = 2048;
-/// Grains per parallel chunk of the integrator loops.
+/// Grains per parallel chunk of the integrator loops and of the force pass (whose chunk owns
+/// the pairs and wall pairs of its grains). Fixed, so that the order in which a grain's forces
+/// are summed does not depend on the thread count.
 const GRAIN_CHUNK: usize = 1024;
 
 /// Parameters of a DEM system, SI.
@@ -138,6 +140,12 @@ struct Part {
     d_f: f64,
     d_r: f64,
     contacts: f64,
+    /// Power of the global damping, Σ α m **v*** · **v**_½.
+    d_glob: f64,
+    /// Power of the external loads, Σ **F**_ext · **v**_½.
+    w_ext: f64,
+    /// Last chunk that this chunk queued forces for (itself if none).
+    reach: u32,
 }
 
 impl Part {
@@ -172,6 +180,8 @@ impl Part {
         self.d_f += o.d_f;
         self.d_r += o.d_r;
         self.contacts += o.contacts;
+        self.d_glob += o.d_glob;
+        self.w_ext += o.w_ext;
         self
     }
 }
@@ -193,8 +203,14 @@ pub struct Dem {
     detector: Detector,
     pairs: PairList,
     wall_pairs: WallList,
+    /// Per grain chunk: sums of the last force pass.
     parts: Vec<Part>,
-    gparts: Vec<[f64; 2]>,
+    /// Per grain chunk: forces of its pairs on grains of later chunks, in pair order.
+    queued: Vec<Vec<JForce>>,
+    /// Per grain chunk r: the first chunk whose `queued` may hold forces on grains of r.
+    reach_from: Vec<u32>,
+    /// Per grain chunk: scratch list of its pairs that touch or touched (see [`candidates`]).
+    cand: Vec<Vec<u32>>,
     /// 1/m and 1/J per grain, refreshed whenever the forces are re-evaluated from scratch
     /// ([`Dem::invalidate_forces`]).
     inv_mass: Vec<f64>,
@@ -206,7 +222,7 @@ pub struct Dem {
     vxp: Vec<f64>,
     vyp: Vec<f64>,
     wp: Vec<f64>,
-    /// Onset/end events of the last force evaluation, one reused buffer per pair chunk.
+    /// Onset/end events of the last force evaluation, one reused buffer per grain chunk.
     events: Vec<Vec<Event>>,
     wall_events: Vec<Vec<Event>>,
     /// Chunks of `events` / `wall_events` filled by the last evaluation.
@@ -315,7 +331,9 @@ impl Dem {
             pairs: PairList::default(),
             wall_pairs: WallList::default(),
             parts: Vec::new(),
-            gparts: Vec::new(),
+            queued: Vec::new(),
+            reach_from: Vec::new(),
+            cand: Vec::new(),
             inv_mass: Vec::new(),
             inv_inertia: Vec::new(),
             moved: true,
@@ -579,8 +597,18 @@ impl Dem {
 
     /// Steps 3–5: rebuild the lists if needed, evaluate all forces at the current positions
     /// and velocities (springs advance by `dt_hist`, 0: evaluate without advancing;
-    /// dissipation accrues over `dt_hist`) and, in the same pass over the grains, apply the
-    /// second half-kick **v** += `kick`·**F**^end/m (`kick` = ½Δt; 0: no kick).
+    /// dissipation accrues over `dt_hist`) and apply the second half-kick
+    /// **v** += `kick`·**F**^end/m (`kick` = ½Δt; 0: no kick).
+    ///
+    /// Two parallel passes over fixed chunks of [`GRAIN_CHUNK`] grains. The pair list is
+    /// sorted by first grain, so a chunk owns a contiguous run of pairs (and of wall pairs).
+    /// *Force pass*: each chunk writes the body forces of its grains, resolves its pairs and
+    /// wall pairs and adds each force straight to its grains; the force of a pair on a second
+    /// grain beyond the chunk is queued, in pair order, in the chunk's own buffer. *Kick
+    /// pass*: each chunk adds the queued forces on its grains (earlier chunks in order, each
+    /// buffer in order) and the rapier contacts, then kicks. Every grain's force is thus
+    /// summed in an order fixed by the pair list and the chunk size, whatever the thread
+    /// count; there is no per-pair force array and no per-grain pair index to gather through.
     fn compute_forces(&mut self, dt_hist: f64, loads: Option<&ExternalLoads>, kick: f64) {
         if self.moved {
             self.moved = false;
@@ -596,149 +624,212 @@ impl Dem {
             self.vyp.clone_from(&self.grains.vy);
             self.wp.clone_from(&self.grains.omega);
         }
-        let g = &self.grains;
-        let (vxp, vyp, wp) = (&self.vxp, &self.vyp, &self.wp);
-        let law = self.grain_law;
-        let (pi, pj) = (&self.pairs.i, &self.pairs.j);
-        let nch = self.pairs.state.len().div_ceil(PAIR_CHUNK);
+        let n = self.grains.len();
+        debug_assert!(self.pairs.first.len() == n + 1 && self.wall_pairs.first.len() == n + 1);
+        let nch = n.div_ceil(GRAIN_CHUNK);
         if self.events.len() < nch {
             self.events.resize_with(nch, Vec::new);
-        }
-        self.event_chunks[0] = nch;
-        self.pairs
-            .state
-            .par_chunks_mut(PAIR_CHUNK)
-            .zip(self.pairs.out.par_chunks_mut(PAIR_CHUNK))
-            .zip(self.pairs.flags.par_chunks_mut(PAIR_CHUNK))
-            .zip(self.events[..nch].par_iter_mut())
-            .enumerate()
-            .map(|(c, (((state, out), flags), ev))| {
-                ev.clear();
-                let o = c * PAIR_CHUNK;
-                let mut part = Part::default();
-                for k in 0..state.len() {
-                    let (i, j) = (pi[o + k] as usize, pj[o + k] as usize);
-                    let (dx, dy) = (g.x[j] - g.x[i], g.y[j] - g.y[i]);
-                    let (ri, rj) = (g.radius[i], g.radius[j]);
-                    let d2 = dx * dx + dy * dy;
-                    let rs = ri + rj;
-                    if d2 >= rs * rs && flags[k] & PAIR_TOUCHING == 0 {
-                        // Apart now and at the previous evaluation.
-                        flags[k] = 0;
-                        continue;
-                    }
-                    let d = d2.sqrt();
-                    let (nx, ny) = if d > 0.0 {
-                        (dx / d, dy / d)
-                    } else {
-                        (1.0, 0.0)
-                    };
-                    let (tx, ty) = (-ny, nx);
-                    // Mid-step (current) and predictor relative velocities.
-                    let (dvx, dvy) = (g.vx[i] - g.vx[j], g.vy[i] - g.vy[j]);
-                    let (wi, wj) = (g.omega[i], g.omega[j]);
-                    let (ex, ey) = (vxp[i] - vxp[j], vyp[i] - vyp[j]);
-                    let (pwi, pwj) = (wp[i], wp[j]);
-                    let (mi, mj) = (g.mass[i], g.mass[j]);
-                    let motion = Motion {
-                        delta: rs - d,
-                        u: [dvx * nx + dvy * ny, ex * nx + ey * ny],
-                        v_t: [
-                            dvx * tx + dvy * ty + wi * ri + wj * rj,
-                            ex * tx + ey * ty + pwi * ri + pwj * rj,
-                        ],
-                        w: [wi - wj, pwi - pwj],
-                        m_eff: mi * mj / (mi + mj),
-                        r_eff: ri * rj / rs,
-                    };
-                    let r = law.resolve(&motion, &mut state[k], dt_hist);
-                    flags[k] = PAIR_ACTIVE | if r.touching { PAIR_TOUCHING } else { 0 };
-                    let [an, at, ar] = r.apply;
-                    out[k] = [
-                        -an * nx + at * tx,
-                        -an * ny + at * ty,
-                        ri * at + ar,
-                        rj * at - ar,
-                    ];
-                    if r.event {
-                        let s = &state[k];
-                        let (dn, dt, dm) = (s.f_n - an, s.f_t - at, s.m_r - ar);
-                        ev.push(Event {
-                            i: i as u32,
-                            j: j as u32,
-                            d: [
-                                -dn * nx + dt * tx,
-                                -dn * ny + dt * ty,
-                                ri * dt + dm,
-                                rj * dt - dm,
-                            ],
-                        });
-                    }
-                    part = part.add(&r);
-                }
-                part
-            })
-            .collect_into_vec(&mut self.parts);
-        let mut total = self.parts.iter().fold(Part::default(), |a, b| a.merge(b));
-        let wlaw = self.wall_law;
-        let walls = &self.walls;
-        let wg = &self.wall_pairs.grain;
-        let ww = &self.wall_pairs.wall;
-        let nch = self.wall_pairs.state.len().div_ceil(PAIR_CHUNK);
-        if self.wall_events.len() < nch {
             self.wall_events.resize_with(nch, Vec::new);
+            self.queued.resize_with(nch, Vec::new);
+            self.cand.resize_with(nch, Vec::new);
         }
-        self.event_chunks[1] = nch;
-        self.wall_pairs
-            .state
-            .par_chunks_mut(PAIR_CHUNK)
-            .zip(self.wall_pairs.out.par_chunks_mut(PAIR_CHUNK))
-            .zip(self.wall_events[..nch].par_iter_mut())
-            .enumerate()
-            .map(|(c, ((state, out), ev))| {
-                ev.clear();
-                let o = c * PAIR_CHUNK;
-                let mut part = Part::default();
-                for k in 0..state.len() {
-                    let i = wg[o + k] as usize;
-                    let (s, [nx, ny]) = walls[ww[o + k] as usize].distance([g.x[i], g.y[i]]);
-                    let ri = g.radius[i];
-                    if s >= ri && !state[k].touching() {
-                        out[k] = [0.0; 3];
-                        continue;
-                    }
-                    let (tx, ty) = (-ny, nx);
-                    let (w, w1) = (g.omega[i], wp[i]);
-                    let motion = Motion {
-                        delta: ri - s,
-                        u: [g.vx[i] * nx + g.vy[i] * ny, vxp[i] * nx + vyp[i] * ny],
-                        v_t: [
-                            g.vx[i] * tx + g.vy[i] * ty + w * ri,
-                            vxp[i] * tx + vyp[i] * ty + w1 * ri,
-                        ],
-                        w: [w, w1],
-                        m_eff: g.mass[i],
-                        r_eff: ri,
-                    };
-                    let r = wlaw.resolve(&motion, &mut state[k], dt_hist);
-                    let [an, at, ar] = r.apply;
-                    out[k] = [-an * nx + at * tx, -an * ny + at * ty, ri * at + ar];
-                    if r.event {
-                        let st = &state[k];
-                        let (dn, dt, dm) = (st.f_n - an, st.f_t - at, st.m_r - ar);
-                        ev.push(Event {
-                            i: i as u32,
-                            j: u32::MAX,
-                            d: [-dn * nx + dt * tx, -dn * ny + dt * ty, ri * dt + dm, 0.0],
-                        });
-                    }
-                    part = part.add(&r);
+        self.event_chunks = [nch, nch];
+        self.parts.resize(nch, Part::default());
+
+        // Force pass.
+        let g = &mut self.grains;
+        let (x, y, vx, vy, om) = (&g.x[..], &g.y[..], &g.vx[..], &g.vy[..], &g.omega[..]);
+        let (rad, m) = (&g.radius[..], &g.mass[..]);
+        let (vxp, vyp, wp) = (&self.vxp[..], &self.vyp[..], &self.wp[..]);
+        let (law, wlaw, walls) = (self.grain_law, self.wall_law, &self.walls);
+        let pl = &mut self.pairs;
+        let wl = &mut self.wall_pairs;
+        let (pi, pj, first) = (&pl.i[..], &pl.j[..], &pl.first[..]);
+        let (wg, ww, wfirst) = (&wl.grain[..], &wl.wall[..], &wl.first[..]);
+        let grav = self.params.gravity;
+        let alpha = self.params.global_damping;
+        let empty: &[f64] = &[];
+        let (lx, ly, lt) = match loads {
+            Some(l) => (&l.fx[..], &l.fy[..], &l.torque[..]),
+            None => (empty, empty, empty),
+        };
+        let span = Span {
+            c0: 0,
+            p0: 0,
+            w0: 0,
+            fx: &mut g.fx,
+            fy: &mut g.fy,
+            tq: &mut g.torque,
+            state: &mut pl.state,
+            flags: &mut pl.flags,
+            wstate: &mut wl.state,
+            events: &mut self.events[..nch],
+            wevents: &mut self.wall_events[..nch],
+            queued: &mut self.queued[..nch],
+            cand: &mut self.cand[..nch],
+            parts: &mut self.parts[..nch],
+        };
+        let force_pass = |s: Span| {
+            let (c, a, len) = (s.c0, s.c0 * GRAIN_CHUNK, s.fx.len());
+            let (fx, fy, tq) = (s.fx, s.fy, s.tq);
+            let (ev, wev, queue) = (&mut s.events[0], &mut s.wevents[0], &mut s.queued[0]);
+            ev.clear();
+            wev.clear();
+            queue.clear();
+            let mut part = Part {
+                reach: c as u32,
+                ..Part::default()
+            };
+            // Gravity, global damping (predictor velocity) and external loads; their work
+            // over the step uses Δx = Δt v_½.
+            for k in 0..len {
+                let i = a + k;
+                fx[k] = m[i] * grav[0];
+                fy[k] = m[i] * grav[1];
+                tq[k] = 0.0;
+                if alpha != 0.0 {
+                    fx[k] -= alpha * m[i] * vxp[i];
+                    fy[k] -= alpha * m[i] * vyp[i];
+                    part.d_glob += alpha * m[i] * (vxp[i] * vx[i] + vyp[i] * vy[i]);
                 }
-                part
-            })
-            .collect_into_vec(&mut self.parts);
-        total = self.parts.iter().fold(total, |a, b| a.merge(b));
-        // Contacts through rapier (polygon grains or walls), summed per grain for the gather.
+                if !lx.is_empty() {
+                    fx[k] += lx[i];
+                    part.w_ext += lx[i] * vx[i];
+                }
+                if !ly.is_empty() {
+                    fy[k] += ly[i];
+                    part.w_ext += ly[i] * vy[i];
+                }
+                if !lt.is_empty() {
+                    tq[k] += lt[i];
+                    part.w_ext += lt[i] * om[i];
+                }
+            }
+            let (state, flags) = (s.state, s.flags);
+            let (p0, end) = (s.p0, a + len);
+            let (ci, cj) = (&pi[p0..p0 + state.len()], &pj[p0..p0 + state.len()]);
+            // Most pairs of a Verlet list are apart now and were apart at the last
+            // evaluation: skip them in a tight first pass.
+            let cand = candidates(ci, cj, flags, x, y, rad, &mut s.cand[0]);
+            for &k in cand {
+                let k = k as usize;
+                let (i, j) = (ci[k] as usize, cj[k] as usize);
+                let (dx, dy) = (x[j] - x[i], y[j] - y[i]);
+                let (ri, rj) = (rad[i], rad[j]);
+                let d2 = dx * dx + dy * dy;
+                let rs = ri + rj;
+                let d = d2.sqrt();
+                let (nx, ny) = if d > 0.0 {
+                    (dx / d, dy / d)
+                } else {
+                    (1.0, 0.0)
+                };
+                let (tx, ty) = (-ny, nx);
+                // Mid-step (current) and predictor relative velocities.
+                let (dvx, dvy) = (vx[i] - vx[j], vy[i] - vy[j]);
+                let (wi, wj) = (om[i], om[j]);
+                let (ex, ey) = (vxp[i] - vxp[j], vyp[i] - vyp[j]);
+                let (pwi, pwj) = (wp[i], wp[j]);
+                let (mi, mj) = (m[i], m[j]);
+                let motion = Motion {
+                    delta: rs - d,
+                    u: [dvx * nx + dvy * ny, ex * nx + ey * ny],
+                    v_t: [
+                        dvx * tx + dvy * ty + wi * ri + wj * rj,
+                        ex * tx + ey * ty + pwi * ri + pwj * rj,
+                    ],
+                    w: [wi - wj, pwi - pwj],
+                    m_eff: mi * mj / (mi + mj),
+                    r_eff: ri * rj / rs,
+                };
+                let r = law.resolve(&motion, &mut state[k], dt_hist);
+                flags[k] = if r.touching { PAIR_TOUCHING } else { 0 };
+                let [an, at, ar] = r.apply;
+                let (f0, f1) = (-an * nx + at * tx, -an * ny + at * ty);
+                let li = i - a;
+                fx[li] += f0;
+                fy[li] += f1;
+                tq[li] += ri * at + ar;
+                if j < end {
+                    let lj = j - a;
+                    fx[lj] -= f0;
+                    fy[lj] -= f1;
+                    tq[lj] += rj * at - ar;
+                } else {
+                    queue.push(JForce {
+                        j: j as u32,
+                        f: [-f0, -f1, rj * at - ar],
+                    });
+                    part.reach = part.reach.max((j / GRAIN_CHUNK) as u32);
+                }
+                if r.event {
+                    let s = &state[k];
+                    let (dn, dt, dm) = (s.f_n - an, s.f_t - at, s.m_r - ar);
+                    ev.push(Event {
+                        i: i as u32,
+                        j: j as u32,
+                        d: [
+                            -dn * nx + dt * tx,
+                            -dn * ny + dt * ty,
+                            ri * dt + dm,
+                            rj * dt - dm,
+                        ],
+                    });
+                }
+                part = part.add(&r);
+            }
+            let (wstate, w0) = (s.wstate, s.w0);
+            for k in 0..wstate.len() {
+                let i = wg[w0 + k] as usize;
+                let (dist, [nx, ny]) = walls[ww[w0 + k] as usize].distance([x[i], y[i]]);
+                let ri = rad[i];
+                if dist >= ri && !wstate[k].touching() {
+                    continue;
+                }
+                let (tx, ty) = (-ny, nx);
+                let (w, w1) = (om[i], wp[i]);
+                let motion = Motion {
+                    delta: ri - dist,
+                    u: [vx[i] * nx + vy[i] * ny, vxp[i] * nx + vyp[i] * ny],
+                    v_t: [
+                        vx[i] * tx + vy[i] * ty + w * ri,
+                        vxp[i] * tx + vyp[i] * ty + w1 * ri,
+                    ],
+                    w: [w, w1],
+                    m_eff: m[i],
+                    r_eff: ri,
+                };
+                let r = wlaw.resolve(&motion, &mut wstate[k], dt_hist);
+                let [an, at, ar] = r.apply;
+                let li = i - a;
+                fx[li] += -an * nx + at * tx;
+                fy[li] += -an * ny + at * ty;
+                tq[li] += ri * at + ar;
+                if r.event {
+                    let st = &wstate[k];
+                    let (dn, dt, dm) = (st.f_n - an, st.f_t - at, st.m_r - ar);
+                    wev.push(Event {
+                        i: i as u32,
+                        j: u32::MAX,
+                        d: [-dn * nx + dt * tx, -dn * ny + dt * ty, ri * dt + dm, 0.0],
+                    });
+                }
+                part = part.add(&r);
+            }
+            s.parts[0] = part;
+        };
+        for_each_chunk(span, first, wfirst, &force_pass);
+        let total = self.parts.iter().fold(Part::default(), |a, b| a.merge(b));
+        // Which earlier chunks queued forces for each chunk.
+        self.reach_from.clear();
+        self.reach_from.extend(0..nch as u32);
+        for (c, p) in self.parts.iter().enumerate() {
+            for r in c + 1..=(p.reach as usize).min(nch - 1) {
+                self.reach_from[r] = self.reach_from[r].min(c as u32);
+            }
+        }
+        // Contacts through rapier (polygon grains or walls), summed per grain.
+        let mut total = total;
         if let Some(sc) = self.shapes.as_mut() {
             let vp = (&self.vxp[..], &self.vyp[..], &self.wp[..]);
             let (gl, wl) = (&self.grain_law, &self.wall_law);
@@ -746,18 +837,10 @@ impl Dem {
             total = total.add_shapes(&s);
         }
         let sf: &[[f64; 3]] = self.shapes.as_ref().map_or(&[], |s| s.grain_force());
-        // Gather per grain: gravity, global damping, external loads, contacts; then kick.
-        let grav = self.params.gravity;
-        let alpha = self.params.global_damping;
-        let (pl, wl) = (&self.pairs, &self.wall_pairs);
+        // Kick pass: queued forces from earlier chunks, rapier contacts, second half-kick.
         let g = &mut self.grains;
-        let (m, x_vx, x_vy) = (&g.mass, &self.vxp, &self.vyp);
         let (im, ij) = (&self.inv_mass, &self.inv_inertia);
-        let empty: &[f64] = &[];
-        let (lx, ly, lt) = match loads {
-            Some(l) => (&l.fx[..], &l.fy[..], &l.torque[..]),
-            None => (empty, empty, empty),
-        };
+        let (queued, reach_from) = (&self.queued, &self.reach_from);
         g.fx.par_chunks_mut(GRAIN_CHUNK)
             .zip(g.fy.par_chunks_mut(GRAIN_CHUNK))
             .zip(g.torque.par_chunks_mut(GRAIN_CHUNK))
@@ -765,78 +848,28 @@ impl Dem {
             .zip(g.vy.par_chunks_mut(GRAIN_CHUNK))
             .zip(g.omega.par_chunks_mut(GRAIN_CHUNK))
             .enumerate()
-            .map(|(c, (((((fx, fy), tq), h_vx), h_vy), h_w))| {
-                let o = c * GRAIN_CHUNK;
-                let (mut d_glob, mut w_ext) = (0.0, 0.0);
-                for k in 0..fx.len() {
-                    let i = o + k;
-                    // Predictor velocity for the damping force; its work and that of
-                    // the (held) external loads over the step use Δx = Δt v_½.
-                    let (vx, vy) = (x_vx[i], x_vy[i]);
-                    let (ux, uy, w) = (h_vx[k], h_vy[k], h_w[k]);
-                    let mut f = [
-                        m[i] * grav[0] - alpha * m[i] * vx,
-                        m[i] * grav[1] - alpha * m[i] * vy,
-                    ];
-                    let mut t = 0.0;
-                    d_glob += alpha * m[i] * (vx * ux + vy * uy);
-                    if !lx.is_empty() {
-                        f[0] += lx[i];
-                        w_ext += lx[i] * ux;
+            .for_each(|(c, (((((fx, fy), tq), vx), vy), w))| {
+                let (a, len) = (c * GRAIN_CHUNK, fx.len());
+                for q in queued[reach_from[c] as usize..c].iter().flatten() {
+                    let k = (q.j as usize).wrapping_sub(a);
+                    if k < len {
+                        fx[k] += q.f[0];
+                        fy[k] += q.f[1];
+                        tq[k] += q.f[2];
                     }
-                    if !ly.is_empty() {
-                        f[1] += ly[i];
-                        w_ext += ly[i] * uy;
-                    }
-                    if !lt.is_empty() {
-                        t += lt[i];
-                        w_ext += lt[i] * w;
-                    }
-                    if i + 1 < pl.first.len() {
-                        for p in pl.first[i] as usize..pl.first[i + 1] as usize {
-                            if pl.flags[p] & PAIR_ACTIVE != 0 {
-                                let q = &pl.out[p];
-                                f[0] += q[0];
-                                f[1] += q[1];
-                                t += q[2];
-                            }
-                        }
-                        for &p in &pl.as_j[pl.j_start[i] as usize..pl.j_start[i + 1] as usize] {
-                            if pl.flags[p as usize] & PAIR_ACTIVE != 0 {
-                                let q = &pl.out[p as usize];
-                                f[0] -= q[0];
-                                f[1] -= q[1];
-                                t += q[3];
-                            }
-                        }
-                    }
-                    if i + 1 < wl.first.len() {
-                        for p in wl.first[i] as usize..wl.first[i + 1] as usize {
-                            let q = &wl.out[p];
-                            f[0] += q[0];
-                            f[1] += q[1];
-                            t += q[2];
-                        }
-                    }
-                    if let Some(q) = sf.get(i) {
-                        f[0] += q[0];
-                        f[1] += q[1];
-                        t += q[2];
-                    }
-                    fx[k] = f[0];
-                    fy[k] = f[1];
-                    tq[k] = t;
-                    h_vx[k] += kick * im[i] * f[0];
-                    h_vy[k] += kick * im[i] * f[1];
-                    h_w[k] += kick * ij[i] * t;
                 }
-                [d_glob, w_ext]
-            })
-            .collect_into_vec(&mut self.gparts);
-        let (d_glob, w_ext) = self
-            .gparts
-            .iter()
-            .fold((0.0, 0.0), |a, b| (a.0 + b[0], a.1 + b[1]));
+                for k in 0..len {
+                    let i = a + k;
+                    if let Some(q) = sf.get(i) {
+                        fx[k] += q[0];
+                        fy[k] += q[1];
+                        tq[k] += q[2];
+                    }
+                    vx[k] += kick * im[i] * fx[k];
+                    vy[k] += kick * im[i] * fy[k];
+                    w[k] += kick * ij[i] * tq[k];
+                }
+            });
         let b = &mut self.budget;
         b.elastic_normal = total.e_n;
         b.elastic_tangential = total.e_t;
@@ -844,9 +877,145 @@ impl Dem {
         b.dissipated_normal += total.d_n;
         b.dissipated_friction += total.d_f;
         b.dissipated_rolling += total.d_r;
-        b.dissipated_global += d_glob * dt_hist;
-        b.work_external += w_ext * dt_hist;
+        b.dissipated_global += total.d_glob * dt_hist;
+        b.work_external += total.w_ext * dt_hist;
         self.contacts = total.contacts as usize;
         self.forces_valid = true;
     }
+}
+
+/// A force queued by one chunk's force pass for a grain of a later chunk.
+#[derive(Clone, Copy, Debug)]
+struct JForce {
+    /// The grain (second grain of the pair).
+    j: u32,
+    /// [F_x, F_y, torque] on it.
+    f: [f64; 3],
+}
+
+/// The force pass's mutable data for a run of whole grain chunks `c0..c0 + parts.len()`: their
+/// grains' force slots, the pairs and wall pairs whose (first) grain lies in them, and one
+/// output buffer of each kind per chunk.
+struct Span<'a> {
+    /// First chunk.
+    c0: usize,
+    /// First pair of the run.
+    p0: usize,
+    /// First wall pair of the run.
+    w0: usize,
+    fx: &'a mut [f64],
+    fy: &'a mut [f64],
+    tq: &'a mut [f64],
+    state: &'a mut [ContactState],
+    flags: &'a mut [u8],
+    wstate: &'a mut [ContactState],
+    events: &'a mut [Vec<Event>],
+    wevents: &'a mut [Vec<Event>],
+    queued: &'a mut [Vec<JForce>],
+    cand: &'a mut [Vec<u32>],
+    parts: &'a mut [Part],
+}
+
+impl Span<'_> {
+    /// Split before chunk `c` (c0 < c < c0 + chunks); `first`/`wfirst` index the pairs and wall
+    /// pairs by grain.
+    fn split(self, c: usize, first: &[u32], wfirst: &[u32]) -> (Self, Self) {
+        let (k, gr) = (c - self.c0, (c - self.c0) * GRAIN_CHUNK);
+        let p = first[c * GRAIN_CHUNK] as usize;
+        let w = wfirst[c * GRAIN_CHUNK] as usize;
+        let (fx0, fx1) = self.fx.split_at_mut(gr);
+        let (fy0, fy1) = self.fy.split_at_mut(gr);
+        let (tq0, tq1) = self.tq.split_at_mut(gr);
+        let (s0, s1) = self.state.split_at_mut(p - self.p0);
+        let (f0, f1) = self.flags.split_at_mut(p - self.p0);
+        let (ws0, ws1) = self.wstate.split_at_mut(w - self.w0);
+        let (e0, e1) = self.events.split_at_mut(k);
+        let (we0, we1) = self.wevents.split_at_mut(k);
+        let (q0, q1) = self.queued.split_at_mut(k);
+        let (c0, c1) = self.cand.split_at_mut(k);
+        let (pa0, pa1) = self.parts.split_at_mut(k);
+        (
+            Span {
+                c0: self.c0,
+                p0: self.p0,
+                w0: self.w0,
+                fx: fx0,
+                fy: fy0,
+                tq: tq0,
+                state: s0,
+                flags: f0,
+                wstate: ws0,
+                events: e0,
+                wevents: we0,
+                queued: q0,
+                cand: c0,
+                parts: pa0,
+            },
+            Span {
+                c0: c,
+                p0: p,
+                w0: w,
+                fx: fx1,
+                fy: fy1,
+                tq: tq1,
+                state: s1,
+                flags: f1,
+                wstate: ws1,
+                events: e1,
+                wevents: we1,
+                queued: q1,
+                cand: c1,
+                parts: pa1,
+            },
+        )
+    }
+}
+
+/// Run `f` on every chunk of `s`, one [`Span`] of one chunk each, splitting in halves with
+/// `rayon::join` (no allocation; which thread runs a chunk does not change what it computes).
+fn for_each_chunk<F: Fn(Span) + Sync>(s: Span, first: &[u32], wfirst: &[u32], f: &F) {
+    match s.parts.len() {
+        0 => {}
+        1 => f(s),
+        n => {
+            let mid = s.c0 + n / 2;
+            let (a, b) = s.split(mid, first, wfirst);
+            rayon::join(
+                || for_each_chunk(a, first, wfirst, f),
+                || for_each_chunk(b, first, wfirst, f),
+            );
+        }
+    }
+}
+
+/// The pairs (indices into `pi`/`pj`) whose grains overlap now or overlapped at the last
+/// evaluation (`flags`), written into `buf` without a branch per pair (≈ 90 % of the pairs
+/// of a Verlet list are apart, in no predictable pattern). Kept out of line so that this loop
+/// has the registers to itself.
+#[inline(never)]
+fn candidates<'b>(
+    pi: &[u32],
+    pj: &[u32],
+    flags: &[u8],
+    x: &[f64],
+    y: &[f64],
+    rad: &[f64],
+    buf: &'b mut Vec<u32>,
+) -> &'b [u32] {
+    let n = pi.len().min(pj.len()).min(flags.len());
+    if buf.len() < n {
+        buf.resize(n, 0);
+    }
+    let mut c = 0;
+    for k in 0..n {
+        let (i, j) = (pi[k] as usize, pj[k] as usize);
+        let (dx, dy) = (x[j] - x[i], y[j] - y[i]);
+        let rs = rad[i] + rad[j];
+        let d2 = dx * dx + dy * dy;
+        // A NaN distance counts as near, so the force loop sees (and propagates) it.
+        let near = d2 < rs * rs || d2.is_nan();
+        buf[c] = k as u32;
+        c += usize::from(near | (flags[k] & PAIR_TOUCHING != 0));
+    }
+    &buf[..c]
 }

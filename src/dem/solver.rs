@@ -24,7 +24,10 @@
 //! whose first grain it holds and adding their forces straight to its grains; a force on a
 //! grain of a later chunk is queued and added by that chunk in the kick pass. Every grain's
 //! force is summed in an order fixed by the pair list and the chunk size, so results do not
-//! depend on the number of threads.
+//! depend on the number of threads. Within a run of several steps ([`Dem::steps`],
+//! [`Dem::advance_with`]) step 5 of one step, its events and steps 1–2 of the next use the
+//! same forces, so they are one pass over the grains (the events of each grain applied in the
+//! same order as the serial loop would: the results are bit for bit those of single steps).
 //!
 //! Time step: seed eq. 5.59–5.60, Δt = λ Δt_cr with λ = 0.1 by default; see [`critical_step`].
 
@@ -232,6 +235,8 @@ pub struct Dem {
     /// filled in by [`Dem::energy`].
     budget: Energy,
     contacts: usize,
+    /// Touching pairs summed over the steps taken.
+    contact_steps: u64,
     /// Pairs the cell list does not handle (polygon grains, polygon walls), through rapier;
     /// `None` for an all-disk system with straight walls.
     shapes: Option<ShapeContacts>,
@@ -346,6 +351,7 @@ impl Dem {
             forces_valid: false,
             budget: Energy::default(),
             contacts: 0,
+            contact_steps: 0,
         })
     }
 
@@ -377,6 +383,11 @@ impl Dem {
     /// Steps taken.
     pub fn step_count(&self) -> u64 {
         self.steps
+    }
+
+    /// Contacts summed over all steps taken (contacts per step × steps).
+    pub fn contact_steps(&self) -> u64 {
+        self.contact_steps
     }
 
     /// Contacts (overlapping pairs, grain–grain and grain–wall) at the last force evaluation.
@@ -455,9 +466,7 @@ impl Dem {
 
     /// `n` steps of size [`Dem::dt`].
     pub fn steps(&mut self, n: u64) {
-        for _ in 0..n {
-            self.step_dt(self.dt, None);
-        }
+        self.run(n, self.dt, None);
     }
 
     /// Advance by `dt` (any size) in ⌈dt/Δt⌉ equal sub-steps no larger than [`Dem::dt`]
@@ -481,9 +490,7 @@ impl Dem {
             return Ok(());
         }
         let (n, h) = crate::scale::substeps(dt, self.dt);
-        for _ in 0..n {
-            self.step_dt(h, loads);
-        }
+        self.run(n, h, loads);
         if let Some(i) = (0..self.grains.len())
             .find(|&i| !(self.grains.x[i].is_finite() && self.grains.y[i].is_finite()))
         {
@@ -497,14 +504,32 @@ impl Dem {
 
     /// One velocity-Verlet step of size `dt` (see the module documentation).
     pub fn step_dt(&mut self, dt: f64, loads: Option<&ExternalLoads>) {
+        self.run(1, dt, loads);
+    }
+
+    /// `n` velocity-Verlet steps of size `dt`. Between two steps the second half-kick, the
+    /// events and the next first half-kick and drift are one pass (not with rapier contacts,
+    /// whose events are applied by [`ShapeContacts`]).
+    fn run(&mut self, n: u64, dt: f64, loads: Option<&ExternalLoads>) {
+        if n == 0 {
+            return;
+        }
         if !self.forces_valid || self.inv_mass.len() != self.grains.len() {
             self.evaluate_from_scratch(loads);
         }
         self.kick_drift(dt);
-        self.compute_forces(dt, loads, 0.5 * dt);
-        self.apply_events();
-        self.time += dt;
-        self.steps += 1;
+        for k in 1..=n {
+            let fused = k < n && self.shapes.is_none();
+            self.compute_forces(dt, loads, 0.5 * dt, fused.then_some(dt));
+            if !fused {
+                self.apply_events();
+            }
+            self.time += dt;
+            self.steps += 1;
+            if !fused && k < n {
+                self.kick_drift(dt);
+            }
+        }
     }
 
     /// Forces at the current state without advancing the springs, after the grains were
@@ -516,66 +541,42 @@ impl Dem {
         self.inv_inertia.clear();
         self.inv_inertia.extend(g.inertia.iter().map(|j| 1.0 / j));
         self.moved = self.detector.needs_rebuild(g);
-        self.compute_forces(0.0, loads, 0.0);
+        self.compute_forces(0.0, loads, 0.0, None);
     }
 
     /// Steps 1–2: first half-kick and drift; also finds whether some grain moved more than
     /// skin/2 since the last list build (step 3), in the same pass.
     fn kick_drift(&mut self, dt: f64) {
-        let h = 0.5 * dt;
         let g = &mut self.grains;
         let n = g.len();
         self.vxp.resize(n, 0.0);
         self.vyp.resize(n, 0.0);
         self.wp.resize(n, 0.0);
-        let (im, ij) = (&self.inv_mass, &self.inv_inertia);
-        let (fx, fy, tq) = (&g.fx, &g.fy, &g.torque);
+        let (im, ij) = (&self.inv_mass[..], &self.inv_inertia[..]);
+        let (fx, fy, tq) = (&g.fx[..], &g.fy[..], &g.torque[..]);
         let (xr, yr, lim) = self.detector.reference();
-        if xr.len() != n {
+        let drift = Drift::new(dt, n, xr, yr, lim);
+        if !drift.has_reference {
             self.moved = true;
         }
-        let moved = g
-            .x
-            .par_chunks_mut(GRAIN_CHUNK)
-            .zip(g.y.par_chunks_mut(GRAIN_CHUNK))
-            .zip(g.vx.par_chunks_mut(GRAIN_CHUNK))
-            .zip(g.vy.par_chunks_mut(GRAIN_CHUNK))
-            .zip(g.angle.par_chunks_mut(GRAIN_CHUNK))
-            .zip(g.omega.par_chunks_mut(GRAIN_CHUNK))
-            .zip(self.vxp.par_chunks_mut(GRAIN_CHUNK))
-            .zip(self.vyp.par_chunks_mut(GRAIN_CHUNK))
-            .zip(self.wp.par_chunks_mut(GRAIN_CHUNK))
-            .enumerate()
-            .map(|(c, ((((((((x, y), vx), vy), th), w), vxp), vyp), wp))| {
-                let (o, len) = (c * GRAIN_CHUNK, x.len());
-                let (im, ij) = (&im[o..o + len], &ij[o..o + len]);
-                let (fx, fy, tq) = (&fx[o..o + len], &fy[o..o + len], &tq[o..o + len]);
-                for k in 0..len {
-                    let (ax, ay, al) = (h * im[k] * fx[k], h * im[k] * fy[k], h * ij[k] * tq[k]);
-                    vx[k] += ax;
-                    vy[k] += ay;
-                    w[k] += al;
-                    x[k] += dt * vx[k];
-                    y[k] += dt * vy[k];
-                    th[k] += dt * w[k];
-                    vxp[k] = vx[k] + ax;
-                    vyp[k] = vy[k] + ay;
-                    wp[k] = w[k] + al;
-                }
-                if xr.len() != n {
-                    return true;
-                }
-                let (xr, yr) = (&xr[o..o + len], &yr[o..o + len]);
-                let mut far = false;
-                for k in 0..len {
-                    let (dx, dy) = (x[k] - xr[k], y[k] - yr[k]);
-                    let r2 = dx * dx + dy * dy;
-                    // A non-finite grain forces a rebuild too.
-                    far |= r2 > lim || r2.is_nan();
-                }
-                far
-            })
-            .reduce(|| false, |a, b| a || b);
+        let moved = kinematics(
+            (
+                &mut g.x,
+                &mut g.y,
+                &mut g.vx,
+                &mut g.vy,
+                &mut g.angle,
+                &mut g.omega,
+            ),
+            (&mut self.vxp, &mut self.vyp, &mut self.wp),
+        )
+        .enumerate()
+        .map(|(c, mut k)| {
+            let o = c * GRAIN_CHUNK;
+            let f = [&fx[o..o + k.x.len()], &fy[o..], &tq[o..]];
+            drift.apply(o, &mut k, f, im, ij)
+        })
+        .reduce(|| false, |a, b| a || b);
         self.moved |= moved;
     }
 
@@ -609,7 +610,16 @@ impl Dem {
     /// buffer in order) and the rapier contacts, then kicks. Every grain's force is thus
     /// summed in an order fixed by the pair list and the chunk size, whatever the thread
     /// count; there is no per-pair force array and no per-grain pair index to gather through.
-    fn compute_forces(&mut self, dt_hist: f64, loads: Option<&ExternalLoads>, kick: f64) {
+    ///
+    /// `next`: the step size of a following step of the same run, whose first half-kick and
+    /// drift (with this step's events applied first) then happen in the kick pass.
+    fn compute_forces(
+        &mut self,
+        dt_hist: f64,
+        loads: Option<&ExternalLoads>,
+        kick: f64,
+        next: Option<f64>,
+    ) {
         if self.moved {
             self.moved = false;
             self.detector.build(
@@ -837,39 +847,86 @@ impl Dem {
             total = total.add_shapes(&s);
         }
         let sf: &[[f64; 3]] = self.shapes.as_ref().map_or(&[], |s| s.grain_force());
-        // Kick pass: queued forces from earlier chunks, rapier contacts, second half-kick.
+        // Kick pass: queued forces from earlier chunks, rapier contacts, second half-kick; in
+        // a run, then this step's events on the chunk's grains and the next kick and drift.
         let g = &mut self.grains;
-        let (im, ij) = (&self.inv_mass, &self.inv_inertia);
+        let n = g.len();
+        let (im, ij) = (&self.inv_mass[..], &self.inv_inertia[..]);
         let (queued, reach_from) = (&self.queued, &self.reach_from);
-        g.fx.par_chunks_mut(GRAIN_CHUNK)
-            .zip(g.fy.par_chunks_mut(GRAIN_CHUNK))
-            .zip(g.torque.par_chunks_mut(GRAIN_CHUNK))
-            .zip(g.vx.par_chunks_mut(GRAIN_CHUNK))
-            .zip(g.vy.par_chunks_mut(GRAIN_CHUNK))
-            .zip(g.omega.par_chunks_mut(GRAIN_CHUNK))
-            .enumerate()
-            .for_each(|(c, (((((fx, fy), tq), vx), vy), w))| {
-                let (a, len) = (c * GRAIN_CHUNK, fx.len());
-                for q in queued[reach_from[c] as usize..c].iter().flatten() {
-                    let k = (q.j as usize).wrapping_sub(a);
-                    if k < len {
-                        fx[k] += q.f[0];
-                        fy[k] += q.f[1];
-                        tq[k] += q.f[2];
-                    }
+        let (events, wevents) = (&self.events[..nch], &self.wall_events[..nch]);
+        let (xr, yr, lim) = self.detector.reference();
+        let drift = next.map(|dt| Drift::new(dt, n, xr, yr, lim));
+        let (fx, fy, tq) = (&mut g.fx, &mut g.fy, &mut g.torque);
+        let moved = kinematics(
+            (
+                &mut g.x,
+                &mut g.y,
+                &mut g.vx,
+                &mut g.vy,
+                &mut g.angle,
+                &mut g.omega,
+            ),
+            (&mut self.vxp, &mut self.vyp, &mut self.wp),
+        )
+        .zip(fx.par_chunks_mut(GRAIN_CHUNK))
+        .zip(fy.par_chunks_mut(GRAIN_CHUNK))
+        .zip(tq.par_chunks_mut(GRAIN_CHUNK))
+        .enumerate()
+        .map(|(c, (((mut k, fx), fy), tq))| {
+            let (a, len) = (c * GRAIN_CHUNK, fx.len());
+            let from = reach_from[c] as usize;
+            for q in queued[from..c].iter().flatten() {
+                let l = (q.j as usize).wrapping_sub(a);
+                if l < len {
+                    fx[l] += q.f[0];
+                    fy[l] += q.f[1];
+                    tq[l] += q.f[2];
                 }
-                for k in 0..len {
-                    let i = a + k;
-                    if let Some(q) = sf.get(i) {
-                        fx[k] += q[0];
-                        fy[k] += q[1];
-                        tq[k] += q[2];
-                    }
-                    vx[k] += kick * im[i] * fx[k];
-                    vy[k] += kick * im[i] * fy[k];
-                    w[k] += kick * ij[i] * tq[k];
+            }
+            for l in 0..len {
+                let i = a + l;
+                if let Some(q) = sf.get(i) {
+                    fx[l] += q[0];
+                    fy[l] += q[1];
+                    tq[l] += q[2];
                 }
-            });
+                k.vx[l] += kick * im[i] * fx[l];
+                k.vy[l] += kick * im[i] * fy[l];
+                k.w[l] += kick * ij[i] * tq[l];
+            }
+            let Some(drift) = &drift else {
+                return false;
+            };
+            // This step's events on the chunk's grains, in the order of the serial loop
+            // (`apply_events`): grain pairs by chunk and pair, then wall pairs.
+            for e in events[from..=c].iter().flatten() {
+                let (i, j) = (
+                    (e.i as usize).wrapping_sub(a),
+                    (e.j as usize).wrapping_sub(a),
+                );
+                if i < len {
+                    fx[i] += e.d[0];
+                    fy[i] += e.d[1];
+                    tq[i] += e.d[2];
+                }
+                if e.j != u32::MAX && j < len {
+                    fx[j] -= e.d[0];
+                    fy[j] -= e.d[1];
+                    tq[j] += e.d[3];
+                }
+            }
+            for e in &wevents[c] {
+                let i = e.i as usize - a;
+                fx[i] += e.d[0];
+                fy[i] += e.d[1];
+                tq[i] += e.d[2];
+            }
+            drift.apply(a, &mut k, [&*fx, &*fy, &*tq], im, ij)
+        })
+        .reduce(|| false, |a, b| a || b);
+        if let Some(d) = &drift {
+            self.moved |= moved || !d.has_reference;
+        }
         let b = &mut self.budget;
         b.elastic_normal = total.e_n;
         b.elastic_tangential = total.e_t;
@@ -880,7 +937,118 @@ impl Dem {
         b.dissipated_global += total.d_glob * dt_hist;
         b.work_external += total.w_ext * dt_hist;
         self.contacts = total.contacts as usize;
+        if dt_hist > 0.0 {
+            self.contact_steps += total.contacts as u64;
+        }
         self.forces_valid = true;
+    }
+}
+
+/// One grain chunk's kinematic arrays: positions, velocities, angle, and the predictor
+/// velocities v* of the dashpots.
+struct Kinematics<'a> {
+    x: &'a mut [f64],
+    y: &'a mut [f64],
+    vx: &'a mut [f64],
+    vy: &'a mut [f64],
+    th: &'a mut [f64],
+    w: &'a mut [f64],
+    vxp: &'a mut [f64],
+    vyp: &'a mut [f64],
+    wp: &'a mut [f64],
+}
+
+/// The grains' kinematic arrays (x, y, v_x, v_y, θ, ω and v*) in chunks of [`GRAIN_CHUNK`].
+#[allow(clippy::type_complexity)]
+fn kinematics<'a>(
+    (x, y, vx, vy, th, w): (
+        &'a mut [f64],
+        &'a mut [f64],
+        &'a mut [f64],
+        &'a mut [f64],
+        &'a mut [f64],
+        &'a mut [f64],
+    ),
+    (vxp, vyp, wp): (&'a mut [f64], &'a mut [f64], &'a mut [f64]),
+) -> impl IndexedParallelIterator<Item = Kinematics<'a>> {
+    let c = GRAIN_CHUNK;
+    x.par_chunks_mut(c)
+        .zip(y.par_chunks_mut(c))
+        .zip(vx.par_chunks_mut(c))
+        .zip(vy.par_chunks_mut(c))
+        .zip(th.par_chunks_mut(c))
+        .zip(w.par_chunks_mut(c))
+        .zip(vxp.par_chunks_mut(c))
+        .zip(vyp.par_chunks_mut(c))
+        .zip(wp.par_chunks_mut(c))
+        .map(
+            |((((((((x, y), vx), vy), th), w), vxp), vyp), wp)| Kinematics {
+                x,
+                y,
+                vx,
+                vy,
+                th,
+                w,
+                vxp,
+                vyp,
+                wp,
+            },
+        )
+}
+
+/// Steps 1–2 of a step of size `dt` and the skin check of step 3.
+struct Drift<'a> {
+    dt: f64,
+    /// Positions at the last list build and the squared skin/2.
+    xr: &'a [f64],
+    yr: &'a [f64],
+    lim: f64,
+    /// Whether the reference positions are those of these grains (else rebuild).
+    has_reference: bool,
+}
+
+impl<'a> Drift<'a> {
+    fn new(dt: f64, n: usize, xr: &'a [f64], yr: &'a [f64], lim: f64) -> Self {
+        Drift {
+            dt,
+            xr,
+            yr,
+            lim,
+            has_reference: xr.len() == n,
+        }
+    }
+
+    /// First half-kick with the forces `f` (chunk-local [F_x, F_y, T]), drift and predictor
+    /// velocities of the chunk starting at grain `o`; whether a grain of it moved more than
+    /// skin/2 since the last list build (or is not finite).
+    fn apply(&self, o: usize, k: &mut Kinematics, f: [&[f64]; 3], im: &[f64], ij: &[f64]) -> bool {
+        let (dt, h, len) = (self.dt, 0.5 * self.dt, k.x.len());
+        let (im, ij) = (&im[o..o + len], &ij[o..o + len]);
+        let (fx, fy, tq) = (&f[0][..len], &f[1][..len], &f[2][..len]);
+        for l in 0..len {
+            let (ax, ay, al) = (h * im[l] * fx[l], h * im[l] * fy[l], h * ij[l] * tq[l]);
+            k.vx[l] += ax;
+            k.vy[l] += ay;
+            k.w[l] += al;
+            k.x[l] += dt * k.vx[l];
+            k.y[l] += dt * k.vy[l];
+            k.th[l] += dt * k.w[l];
+            k.vxp[l] = k.vx[l] + ax;
+            k.vyp[l] = k.vy[l] + ay;
+            k.wp[l] = k.w[l] + al;
+        }
+        if !self.has_reference {
+            return true;
+        }
+        let (xr, yr) = (&self.xr[o..o + len], &self.yr[o..o + len]);
+        let mut far = false;
+        for l in 0..len {
+            let (dx, dy) = (k.x[l] - xr[l], k.y[l] - yr[l]);
+            let r2 = dx * dx + dy * dy;
+            // A non-finite grain forces a rebuild too.
+            far |= r2 > self.lim || r2.is_nan();
+        }
+        far
     }
 }
 

@@ -90,6 +90,37 @@ impl Wall {
         }
     }
 
+    /// Whether the condition acts on a node moving at `v` (the momentum update's velocity):
+    /// always, except for a unilateral `Friction` wall, which acts only while the node moves
+    /// into it (v_n < 0).
+    #[inline]
+    pub fn engages(&self, v: [f64; 2]) -> bool {
+        match self.kind {
+            WallKind::Friction { .. } => {
+                let n = self.normal();
+                v[0] * n[0] + v[1] * n[1] < 0.0
+            }
+            _ => true,
+        }
+    }
+
+    /// The condition on a re-mapped velocity (MUSL) of a node whose contact state the momentum
+    /// update of the same step decided (`engaged`, see [`Wall::engages`]): a unilateral wall in
+    /// contact keeps the node on it (v_n = 0) even where the re-mapped v_n ≥ 0, since the
+    /// nodal velocity v^{n+1} it re-maps has v_n = 0 there; otherwise as [`Wall::apply`].
+    #[inline]
+    pub fn apply_engaged(&self, v: &mut [f64; 2], engaged: bool) -> ([f64; 2], [f64; 2]) {
+        if let WallKind::Friction { .. } = self.kind {
+            let n = self.normal();
+            let vn = v[0] * n[0] + v[1] * n[1];
+            if engaged && vn >= 0.0 {
+                *v = [v[0] - vn * n[0], v[1] - vn * n[1]];
+                return ([-vn * n[0], -vn * n[1]], [0.0; 2]);
+            }
+        }
+        self.apply(v)
+    }
+
     /// Apply the condition to the velocity `v` of a node; returns the velocity change, split
     /// into (normal, tangential) parts.
     #[inline]
@@ -159,6 +190,33 @@ mod tests {
         let mut v = [0.3, -0.4];
         r.apply(&mut v);
         assert_eq!(v, [0.0, -0.4]);
+    }
+
+    /// A friction wall engaged by the momentum update holds a re-mapped velocity that separates
+    /// (v_n ≥ 0) on the wall; not engaged, it leaves it free; approaching, it acts as `apply`.
+    #[test]
+    fn engaged_friction_wall_holds_the_remapped_velocity() {
+        let w = Wall {
+            side: Side::Bottom,
+            position: 0.0,
+            kind: WallKind::Friction { mu: 0.5 },
+        };
+        assert!(w.engages([0.3, -0.1]) && !w.engages([0.3, 0.1]));
+        let mut v = [0.3, 0.7];
+        assert_eq!(w.apply_engaged(&mut v, true), ([0.0, -0.7], [0.0; 2]));
+        assert_eq!(v, [0.3, 0.0]);
+        let mut v = [0.3, 0.7];
+        assert_eq!(w.apply_engaged(&mut v, false), ([0.0; 2], [0.0; 2]));
+        assert_eq!(v, [0.3, 0.7]);
+        let (mut a, mut b) = ([2.0, -1.0], [2.0, -1.0]);
+        assert_eq!(w.apply_engaged(&mut a, true), w.apply(&mut b));
+        assert_eq!(a, b);
+        let r = Wall {
+            side: Side::Left,
+            position: 0.0,
+            kind: WallKind::Roller,
+        };
+        assert!(r.engages([1.0, 0.0]));
     }
 
     /// A platen sets the normal velocity (into the material) and leaves the tangential one;

@@ -28,6 +28,9 @@ pub struct Grid {
     pub vel_map: Vec<[f64; 2]>,
     /// Bit k set: wall k constrains this node.
     pub walls_mask: Vec<u8>,
+    /// Bit k set: wall k acted on this node in the last momentum update (contact state of
+    /// the step, see [`Wall::engages`]; re-applied to the MUSL re-mapped velocity).
+    pub contact: Vec<u8>,
     /// The walls.
     pub walls: Vec<Wall>,
 }
@@ -57,6 +60,7 @@ impl Grid {
             vel_new: vec![[0.0; 2]; n],
             vel_map: vec![[0.0; 2]; n],
             walls_mask,
+            contact: vec![0u8; n],
             walls,
         }
     }
@@ -79,6 +83,45 @@ impl Grid {
             self.origin[0] + i as f64 * self.h,
             self.origin[1] + j as f64 * self.h,
         ]
+    }
+
+    /// As [`Grid::constrain`], also returning the walls that acted (bit k: wall k engaged, see
+    /// [`Wall::engages`]; each wall sees the velocity the walls before it left).
+    #[inline]
+    pub fn constrain_tracked(
+        walls: &[Wall],
+        mask: u8,
+        v: &mut [f64; 2],
+    ) -> ([f64; 2], [f64; 2], u8) {
+        let mut dn = [0.0; 2];
+        let mut dt = [0.0; 2];
+        let mut engaged = 0u8;
+        if mask != 0 {
+            for (k, w) in walls.iter().enumerate() {
+                if mask & (1 << k) != 0 {
+                    if w.engages(*v) {
+                        engaged |= 1 << k;
+                    }
+                    let (a, b) = w.apply(v);
+                    dn = [dn[0] + a[0], dn[1] + a[1]];
+                    dt = [dt[0] + b[0], dt[1] + b[1]];
+                }
+            }
+        }
+        (dn, dt, engaged)
+    }
+
+    /// The walls of a node applied to a re-mapped velocity (MUSL), with the contact state
+    /// `engaged` of the step's momentum update (see [`Wall::apply_engaged`]).
+    #[inline]
+    pub fn constrain_remap(walls: &[Wall], mask: u8, engaged: u8, v: &mut [f64; 2]) {
+        if mask != 0 {
+            for (k, w) in walls.iter().enumerate() {
+                if mask & (1 << k) != 0 {
+                    w.apply_engaged(v, engaged & (1 << k) != 0);
+                }
+            }
+        }
     }
 
     /// Apply the walls of a node (bit mask `mask`) to its velocity `v`; returns the total

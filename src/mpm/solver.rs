@@ -14,7 +14,12 @@
 //!   f_i = Σ_p (−V_p σ_p·∇N_ip + N_ip m_p g);
 //! * local non-viscous damping (Cundall), when α > 0: f_i ← f_i − α |f_i| sign(v_i) per
 //!   component (used only to reach static equilibrium, e.g. `mpm-selfweight`);
-//! * v_i^{n+1} = v_i + Δt f_i/m_i, then the walls ([`super::boundary`]);
+//! * v_i^{n+1} = v_i + Δt f_i/m_i, then the walls ([`super::boundary`]); the walls that act
+//!   on each node (a unilateral friction wall only where the node moves into it) are the
+//!   step's contact state, which MUSL re-applies to the re-mapped velocity: a node held on a
+//!   wall by the update stays on it (v_n = 0) there, even where the re-mapped FLIP velocities
+//!   move away from the wall (releasing it let a compressed point on the floor compress
+//!   itself further each step, and be ejected);
 //! * FLIP velocity v_p ← v_p + Σ_i N_ip (v_i^{n+1} − v_i) (optionally blended with PIC,
 //!   [`MpmParams::pic_fraction`]), position x_p ← x_p + Δt Σ_i N_ip v_i^{n+1};
 //! * or, with [`Transfer::Apic`] (affine PIC, Jiang et al. 2015): P2G momentum
@@ -738,21 +743,28 @@ impl Mpm {
     }
 
     /// Grid velocities from momenta: `vel` = p/m (unconstrained; the FLIP reference) and, when
-    /// `constrained_map`, `vel_map` = p/m with the walls applied (energy not booked: the
-    /// momentum is not changed).
-    fn grid_velocity(&mut self, into_map: bool) {
+    /// `into_map`, `vel_map` = p/m with the walls applied (energy not booked: the momentum is
+    /// not changed). With `remap` (MUSL, after the momentum update) the walls keep the contact
+    /// state that the update gave each node ([`Grid::constrain_remap`]): the re-mapped field
+    /// stands for the same v^{n+1}, so a node that the update held on a unilateral wall is
+    /// held there, not released because the re-mapped FLIP velocities point away from it.
+    fn grid_velocity(&mut self, into_map: bool, remap: bool) {
         let g = &mut self.grid;
         let eps = self.mass_eps;
         let walls = &g.walls;
+        let contact = &g.contact;
         let target = if into_map { &mut g.vel_map } else { &mut g.vel };
         target
             .par_iter_mut()
             .zip(g.sums.par_iter())
             .zip(g.walls_mask.par_iter())
-            .for_each(|((v, s), &mask)| {
+            .zip(contact.par_iter())
+            .for_each(|(((v, s), &mask), &engaged)| {
                 if s[0] > eps {
                     *v = [s[1] / s[0], s[2] / s[0]];
-                    if into_map {
+                    if into_map && remap {
+                        Grid::constrain_remap(walls, mask, engaged, v);
+                    } else if into_map {
                         Grid::constrain(walls, mask, v);
                     }
                 } else {
@@ -772,9 +784,11 @@ impl Mpm {
             .zip(g.vel.par_iter())
             .zip(g.sums.par_iter())
             .zip(g.walls_mask.par_iter())
-            .map(|(((vn, v), s), &mask)| {
+            .zip(g.contact.par_iter_mut())
+            .map(|((((vn, v), s), &mask), engaged)| {
                 if s[0] <= eps {
                     *vn = [0.0; 2];
+                    *engaged = 0;
                     return [0.0; 3];
                 }
                 let mut f = [s[3], s[4]];
@@ -787,7 +801,8 @@ impl Mpm {
                     }
                 }
                 *vn = [v[0] + dt * f[0] / s[0], v[1] + dt * f[1] / s[0]];
-                let (dn, dtan) = Grid::constrain(walls, mask, vn);
+                let (dn, dtan, on) = Grid::constrain_tracked(walls, mask, vn);
+                *engaged = on;
                 // Work of the wall impulse m Δv at the midpoint velocity (v^{n+1} + v^n)/2.
                 let mid = [0.5 * (vn[0] + v[0]), 0.5 * (vn[1] + v[1])];
                 let en = -s[0] * (dn[0] * mid[0] + dn[1] * mid[1]);
@@ -969,29 +984,29 @@ impl Mpm {
         match self.params.scheme {
             Scheme::Usf => {
                 self.p2g(true, false, false);
-                self.grid_velocity(true);
+                self.grid_velocity(true, false);
                 self.point_pass(PointPass::StressFromMap)?;
                 self.p2g(false, true, false);
                 self.scatter_tractions();
-                self.grid_velocity(false);
+                self.grid_velocity(false, false);
                 self.grid_update();
                 self.point_pass(PointPass::VelocityAndMove)?;
             }
             Scheme::Usl => {
                 self.p2g(true, true, false);
                 self.scatter_tractions();
-                self.grid_velocity(false);
+                self.grid_velocity(false, false);
                 self.grid_update();
                 self.point_pass(PointPass::All)?;
             }
             Scheme::Musl => {
                 self.p2g(true, true, false);
                 self.scatter_tractions();
-                self.grid_velocity(false);
+                self.grid_velocity(false, false);
                 self.grid_update();
                 self.point_pass(PointPass::Velocity)?;
                 self.p2g(false, false, true);
-                self.grid_velocity(true);
+                self.grid_velocity(true, true);
                 self.point_pass(PointPass::StressFromMapAndMove)?;
             }
         }
@@ -1084,7 +1099,7 @@ impl Mpm {
     pub fn map_to_grid(&mut self) -> Result<()> {
         self.bin()?;
         self.p2g(true, false, false);
-        self.grid_velocity(false);
+        self.grid_velocity(false, false);
         Ok(())
     }
 

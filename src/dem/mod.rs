@@ -42,5 +42,5 @@ pub mod walls;
 pub use contact::{damping_ratio, restitution_of, ContactParams};
 pub use energy::Energy;
 pub use grains::Grains;
-pub use solver::{critical_step, Dem, DemParams, ExternalLoads};
+pub use solver::{critical_step, Dem, DemParams, ExternalLoads, Overlap, OVERLAP_LIMIT};
 pub use walls::Wall;

@@ -149,7 +149,35 @@ struct Part {
     w_ext: f64,
     /// Last chunk that this chunk queued forces for (itself if none).
     reach: u32,
+    /// Deepest overlap δ/min(R_i, R_j) of the pass and its pair (j = `u32::MAX`: a wall).
+    deepest: Overlap,
 }
+
+/// An overlap δ relative to the smaller radius of the pair, and the pair.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Overlap {
+    /// δ/min(R_i, R_j) (δ/R_i for a wall).
+    pub relative: f64,
+    /// Grain i.
+    pub i: u32,
+    /// Grain j, or `u32::MAX` for a wall.
+    pub j: u32,
+}
+
+impl Overlap {
+    #[inline(always)]
+    fn deeper(self, o: Overlap) -> Overlap {
+        if o.relative > self.relative {
+            o
+        } else {
+            self
+        }
+    }
+}
+
+/// Overlap δ/min(R_i, R_j) beyond which a run stops as unstable: the grains are passing
+/// through each other (time step too large or stiffness too low for the impact speeds).
+pub const OVERLAP_LIMIT: f64 = 0.5;
 
 impl Part {
     #[inline(always)]
@@ -185,6 +213,7 @@ impl Part {
         self.contacts += o.contacts;
         self.d_glob += o.d_glob;
         self.w_ext += o.w_ext;
+        self.deepest = self.deepest.deeper(o.deepest);
         self
     }
 }
@@ -235,6 +264,9 @@ pub struct Dem {
     /// filled in by [`Dem::energy`].
     budget: Energy,
     contacts: usize,
+    /// Deepest overlap of the disk contacts since the start of the last
+    /// [`Dem::advance_with`] (or since creation).
+    deepest: Overlap,
     /// Touching pairs summed over the steps taken.
     contact_steps: u64,
     /// Pairs the cell list does not handle (polygon grains, polygon walls), through rapier;
@@ -351,6 +383,7 @@ impl Dem {
             forces_valid: false,
             budget: Energy::default(),
             contacts: 0,
+            deepest: Overlap::default(),
             contact_steps: 0,
         })
     }
@@ -383,6 +416,13 @@ impl Dem {
     /// Steps taken.
     pub fn step_count(&self) -> u64 {
         self.steps
+    }
+
+    /// Deepest overlap δ/min(R_i, R_j) of the disk contacts over the steps since the start of
+    /// the last [`Dem::advance_with`] (or since creation); that call fails when it exceeds
+    /// [`OVERLAP_LIMIT`].
+    pub fn deepest_overlap(&self) -> Overlap {
+        self.deepest
     }
 
     /// Contacts summed over all steps taken (contacts per step × steps).
@@ -490,6 +530,7 @@ impl Dem {
             return Ok(());
         }
         let (n, h) = crate::scale::substeps(dt, self.dt);
+        self.deepest = Overlap::default();
         self.run(n, h, loads);
         if let Some(i) = (0..self.grains.len())
             .find(|&i| !(self.grains.x[i].is_finite() && self.grains.y[i].is_finite()))
@@ -497,6 +538,20 @@ impl Dem {
             return Err(Error::Other(format!(
                 "DEM unstable at step {} (t = {:.6e} s): grain {i} has a non-finite position",
                 self.steps, self.time
+            )));
+        }
+        let o = self.deepest;
+        if o.relative > OVERLAP_LIMIT {
+            let with = if o.j == u32::MAX {
+                "a wall".to_string()
+            } else {
+                format!("grain {}", o.j)
+            };
+            return Err(Error::Other(format!(
+                "DEM unstable at step {} (t = {:.6e} s): grain {} overlaps {with} by {:.3} of \
+                 the smaller radius (limit {OVERLAP_LIMIT}): the grains are passing through \
+                 each other; lower the time step or raise the stiffness",
+                self.steps, self.time, o.i, o.relative
             )));
         }
         Ok(())
@@ -754,6 +809,11 @@ impl Dem {
                 };
                 let r = law.resolve(&motion, &mut state[k], dt_hist);
                 flags[k] = if r.touching { PAIR_TOUCHING } else { 0 };
+                part.deepest = part.deepest.deeper(Overlap {
+                    relative: motion.delta / ri.min(rj),
+                    i: i as u32,
+                    j: j as u32,
+                });
                 let [an, at, ar] = r.apply;
                 let (f0, f1) = (-an * nx + at * tx, -an * ny + at * ty);
                 let li = i - a;
@@ -810,6 +870,11 @@ impl Dem {
                     r_eff: ri,
                 };
                 let r = wlaw.resolve(&motion, &mut wstate[k], dt_hist);
+                part.deepest = part.deepest.deeper(Overlap {
+                    relative: motion.delta / ri,
+                    i: i as u32,
+                    j: u32::MAX,
+                });
                 let [an, at, ar] = r.apply;
                 let li = i - a;
                 fx[li] += -an * nx + at * tx;
@@ -937,6 +1002,7 @@ impl Dem {
         b.dissipated_global += total.d_glob * dt_hist;
         b.work_external += total.w_ext * dt_hist;
         self.contacts = total.contacts as usize;
+        self.deepest = self.deepest.deeper(total.deepest);
         if dt_hist > 0.0 {
             self.contact_steps += total.contacts as u64;
         }

@@ -267,15 +267,24 @@ impl Event {
     /// Add the difference to the force arrays of `g` (−F on j, its own torque).
     #[inline]
     pub fn apply(&self, g: &mut super::grains::Grains) {
-        let (i, d) = (self.i as usize, self.d);
-        g.fx[i] += d[0];
-        g.fy[i] += d[1];
-        g.torque[i] += d[2];
-        if self.j != u32::MAX {
-            let j = self.j as usize;
-            g.fx[j] -= d[0];
-            g.fy[j] -= d[1];
-            g.torque[j] += d[3];
+        self.apply_to_chunk(0, &mut g.fx, &mut g.fy, &mut g.torque);
+    }
+
+    /// [`Event::apply`] on the grains `first..first + fx.len()` only, whose force slots are
+    /// `fx`, `fy`, `tq` (the part of the difference on other grains is left out).
+    #[inline]
+    pub fn apply_to_chunk(&self, first: usize, fx: &mut [f64], fy: &mut [f64], tq: &mut [f64]) {
+        let (i, d, len) = ((self.i as usize).wrapping_sub(first), self.d, fx.len());
+        if i < len {
+            fx[i] += d[0];
+            fy[i] += d[1];
+            tq[i] += d[2];
+        }
+        let j = (self.j as usize).wrapping_sub(first);
+        if self.j != u32::MAX && j < len {
+            fx[j] -= d[0];
+            fy[j] -= d[1];
+            tq[j] += d[3];
         }
     }
 }

@@ -608,30 +608,15 @@ impl Dem {
         self.vyp.resize(n, 0.0);
         self.wp.resize(n, 0.0);
         let (im, ij) = (&self.inv_mass[..], &self.inv_inertia[..]);
-        let (fx, fy, tq) = (&g.fx[..], &g.fy[..], &g.torque[..]);
         let (xr, yr, lim) = self.detector.reference();
         let drift = Drift::new(dt, n, xr, yr, lim);
         if !drift.has_reference {
             self.moved = true;
         }
-        let moved = kinematics(
-            (
-                &mut g.x,
-                &mut g.y,
-                &mut g.vx,
-                &mut g.vy,
-                &mut g.angle,
-                &mut g.omega,
-            ),
-            (&mut self.vxp, &mut self.vyp, &mut self.wp),
-        )
-        .enumerate()
-        .map(|(c, mut k)| {
-            let o = c * GRAIN_CHUNK;
-            let f = [&fx[o..o + k.x.len()], &fy[o..], &tq[o..]];
-            drift.apply(o, &mut k, f, im, ij)
-        })
-        .reduce(|| false, |a, b| a || b);
+        let moved = chunks(g, &mut self.vxp, &mut self.vyp, &mut self.wp)
+            .enumerate()
+            .map(|(c, mut k)| drift.apply(c * GRAIN_CHUNK, &mut k, im, ij))
+            .reduce(|| false, |a, b| a || b);
         self.moved |= moved;
     }
 
@@ -921,74 +906,42 @@ impl Dem {
         let (events, wevents) = (&self.events[..nch], &self.wall_events[..nch]);
         let (xr, yr, lim) = self.detector.reference();
         let drift = next.map(|dt| Drift::new(dt, n, xr, yr, lim));
-        let (fx, fy, tq) = (&mut g.fx, &mut g.fy, &mut g.torque);
-        let moved = kinematics(
-            (
-                &mut g.x,
-                &mut g.y,
-                &mut g.vx,
-                &mut g.vy,
-                &mut g.angle,
-                &mut g.omega,
-            ),
-            (&mut self.vxp, &mut self.vyp, &mut self.wp),
-        )
-        .zip(fx.par_chunks_mut(GRAIN_CHUNK))
-        .zip(fy.par_chunks_mut(GRAIN_CHUNK))
-        .zip(tq.par_chunks_mut(GRAIN_CHUNK))
-        .enumerate()
-        .map(|(c, (((mut k, fx), fy), tq))| {
-            let (a, len) = (c * GRAIN_CHUNK, fx.len());
-            let from = reach_from[c] as usize;
-            for q in queued[from..c].iter().flatten() {
-                let l = (q.j as usize).wrapping_sub(a);
-                if l < len {
-                    fx[l] += q.f[0];
-                    fy[l] += q.f[1];
-                    tq[l] += q.f[2];
+        let moved = chunks(g, &mut self.vxp, &mut self.vyp, &mut self.wp)
+            .enumerate()
+            .map(|(c, mut k)| {
+                let (fx, fy, tq) = (&mut *k.fx, &mut *k.fy, &mut *k.tq);
+                let (a, len) = (c * GRAIN_CHUNK, fx.len());
+                let from = reach_from[c] as usize;
+                for q in queued[from..c].iter().flatten() {
+                    let l = (q.j as usize).wrapping_sub(a);
+                    if l < len {
+                        fx[l] += q.f[0];
+                        fy[l] += q.f[1];
+                        tq[l] += q.f[2];
+                    }
                 }
-            }
-            for l in 0..len {
-                let i = a + l;
-                if let Some(q) = sf.get(i) {
-                    fx[l] += q[0];
-                    fy[l] += q[1];
-                    tq[l] += q[2];
+                for l in 0..len {
+                    let i = a + l;
+                    if let Some(q) = sf.get(i) {
+                        fx[l] += q[0];
+                        fy[l] += q[1];
+                        tq[l] += q[2];
+                    }
+                    k.vx[l] += kick * im[i] * fx[l];
+                    k.vy[l] += kick * im[i] * fy[l];
+                    k.w[l] += kick * ij[i] * tq[l];
                 }
-                k.vx[l] += kick * im[i] * fx[l];
-                k.vy[l] += kick * im[i] * fy[l];
-                k.w[l] += kick * ij[i] * tq[l];
-            }
-            let Some(drift) = &drift else {
-                return false;
-            };
-            // This step's events on the chunk's grains, in the order of the serial loop
-            // (`apply_events`): grain pairs by chunk and pair, then wall pairs.
-            for e in events[from..=c].iter().flatten() {
-                let (i, j) = (
-                    (e.i as usize).wrapping_sub(a),
-                    (e.j as usize).wrapping_sub(a),
-                );
-                if i < len {
-                    fx[i] += e.d[0];
-                    fy[i] += e.d[1];
-                    tq[i] += e.d[2];
+                let Some(drift) = &drift else {
+                    return false;
+                };
+                // This step's events on the chunk's grains, in the order of the serial loop
+                // (`apply_events`): grain pairs by chunk and pair, then wall pairs.
+                for e in events[from..=c].iter().flatten().chain(&wevents[c]) {
+                    e.apply_to_chunk(a, fx, fy, tq);
                 }
-                if e.j != u32::MAX && j < len {
-                    fx[j] -= e.d[0];
-                    fy[j] -= e.d[1];
-                    tq[j] += e.d[3];
-                }
-            }
-            for e in &wevents[c] {
-                let i = e.i as usize - a;
-                fx[i] += e.d[0];
-                fy[i] += e.d[1];
-                tq[i] += e.d[2];
-            }
-            drift.apply(a, &mut k, [&*fx, &*fy, &*tq], im, ij)
-        })
-        .reduce(|| false, |a, b| a || b);
+                drift.apply(a, &mut k, im, ij)
+            })
+            .reduce(|| false, |a, b| a || b);
         if let Some(d) = &drift {
             self.moved |= moved || !d.has_reference;
         }
@@ -1010,9 +963,9 @@ impl Dem {
     }
 }
 
-/// One grain chunk's kinematic arrays: positions, velocities, angle, and the predictor
-/// velocities v* of the dashpots.
-struct Kinematics<'a> {
+/// One grain chunk's arrays as the integrator passes see them: positions, velocities, angle,
+/// the predictor velocities v* of the dashpots, and the force, torque.
+struct Chunk<'a> {
     x: &'a mut [f64],
     y: &'a mut [f64],
     vx: &'a mut [f64],
@@ -1022,33 +975,33 @@ struct Kinematics<'a> {
     vxp: &'a mut [f64],
     vyp: &'a mut [f64],
     wp: &'a mut [f64],
+    fx: &'a mut [f64],
+    fy: &'a mut [f64],
+    tq: &'a mut [f64],
 }
 
-/// The grains' kinematic arrays (x, y, v_x, v_y, θ, ω and v*) in chunks of [`GRAIN_CHUNK`].
-#[allow(clippy::type_complexity)]
-fn kinematics<'a>(
-    (x, y, vx, vy, th, w): (
-        &'a mut [f64],
-        &'a mut [f64],
-        &'a mut [f64],
-        &'a mut [f64],
-        &'a mut [f64],
-        &'a mut [f64],
-    ),
-    (vxp, vyp, wp): (&'a mut [f64], &'a mut [f64], &'a mut [f64]),
-) -> impl IndexedParallelIterator<Item = Kinematics<'a>> {
+/// The grains (and their predictor velocities) in chunks of [`GRAIN_CHUNK`].
+fn chunks<'a>(
+    g: &'a mut Grains,
+    vxp: &'a mut [f64],
+    vyp: &'a mut [f64],
+    wp: &'a mut [f64],
+) -> impl IndexedParallelIterator<Item = Chunk<'a>> {
     let c = GRAIN_CHUNK;
-    x.par_chunks_mut(c)
-        .zip(y.par_chunks_mut(c))
-        .zip(vx.par_chunks_mut(c))
-        .zip(vy.par_chunks_mut(c))
-        .zip(th.par_chunks_mut(c))
-        .zip(w.par_chunks_mut(c))
+    g.x.par_chunks_mut(c)
+        .zip(g.y.par_chunks_mut(c))
+        .zip(g.vx.par_chunks_mut(c))
+        .zip(g.vy.par_chunks_mut(c))
+        .zip(g.angle.par_chunks_mut(c))
+        .zip(g.omega.par_chunks_mut(c))
         .zip(vxp.par_chunks_mut(c))
         .zip(vyp.par_chunks_mut(c))
         .zip(wp.par_chunks_mut(c))
+        .zip(g.fx.par_chunks_mut(c))
+        .zip(g.fy.par_chunks_mut(c))
+        .zip(g.torque.par_chunks_mut(c))
         .map(
-            |((((((((x, y), vx), vy), th), w), vxp), vyp), wp)| Kinematics {
+            |(((((((((((x, y), vx), vy), th), w), vxp), vyp), wp), fx), fy), tq)| Chunk {
                 x,
                 y,
                 vx,
@@ -1058,6 +1011,9 @@ fn kinematics<'a>(
                 vxp,
                 vyp,
                 wp,
+                fx,
+                fy,
+                tq,
             },
         )
 }
@@ -1084,15 +1040,18 @@ impl<'a> Drift<'a> {
         }
     }
 
-    /// First half-kick with the forces `f` (chunk-local [F_x, F_y, T]), drift and predictor
-    /// velocities of the chunk starting at grain `o`; whether a grain of it moved more than
-    /// skin/2 since the last list build (or is not finite).
-    fn apply(&self, o: usize, k: &mut Kinematics, f: [&[f64]; 3], im: &[f64], ij: &[f64]) -> bool {
+    /// First half-kick with the chunk's forces, drift and predictor velocities of the chunk
+    /// starting at grain `o`; whether a grain of it moved more than skin/2 since the last
+    /// list build (or is not finite).
+    fn apply(&self, o: usize, k: &mut Chunk, im: &[f64], ij: &[f64]) -> bool {
         let (dt, h, len) = (self.dt, 0.5 * self.dt, k.x.len());
         let (im, ij) = (&im[o..o + len], &ij[o..o + len]);
-        let (fx, fy, tq) = (&f[0][..len], &f[1][..len], &f[2][..len]);
         for l in 0..len {
-            let (ax, ay, al) = (h * im[l] * fx[l], h * im[l] * fy[l], h * ij[l] * tq[l]);
+            let (ax, ay, al) = (
+                h * im[l] * k.fx[l],
+                h * im[l] * k.fy[l],
+                h * ij[l] * k.tq[l],
+            );
             k.vx[l] += ax;
             k.vy[l] += ay;
             k.w[l] += al;

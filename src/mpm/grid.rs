@@ -128,17 +128,7 @@ impl Grid {
     /// velocity change (normal parts, tangential parts).
     #[inline]
     pub fn constrain(walls: &[Wall], mask: u8, v: &mut [f64; 2]) -> ([f64; 2], [f64; 2]) {
-        let mut dn = [0.0; 2];
-        let mut dt = [0.0; 2];
-        if mask != 0 {
-            for (k, w) in walls.iter().enumerate() {
-                if mask & (1 << k) != 0 {
-                    let (a, b) = w.apply(v);
-                    dn = [dn[0] + a[0], dn[1] + a[1]];
-                    dt = [dt[0] + b[0], dt[1] + b[1]];
-                }
-            }
-        }
+        let (dn, dt, _) = Self::constrain_tracked(walls, mask, v);
         (dn, dt)
     }
 }

@@ -82,6 +82,7 @@ rolling_damping = 5.0e-7
 rolling_friction = 0.1
 [deposition]
 friction = 0.5
+rolling_friction = 0.1
 rest_fraction = 1.0e-5
 max_time = 3.0
 [time]
@@ -118,6 +119,11 @@ fn bad_values_are_refused_with_the_field_named() {
         ),
         ("lambda = 0.1", "lambda = 0.0", "time.lambda"),
         ("density = 2500.0", "density = -1.0", "grains.density"),
+        (
+            "rolling_friction = 0.1\nrest_fraction",
+            "rolling_friction = -0.1\nrest_fraction",
+            "deposition.rolling_friction",
+        ),
     ] {
         assert!(base.contains(from), "{from}");
         let s = DemScenario::from_toml(&base.replacen(from, to, 1)).unwrap();

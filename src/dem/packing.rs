@@ -127,8 +127,13 @@ pub struct ColumnSpec {
     /// Areal density (kg/m² in plane 2-D).
     pub density: f64,
     /// Contact laws during deposition. Friction controls the packing: μ = 0 gives a dense
-    /// packing, μ ≈ 0.5 a loose one.
+    /// packing, μ ≈ 0.5 a loose one; a rolling-friction cap above the material's holds the
+    /// fall in still looser arches.
     pub params: DemParams,
+    /// The material's own laws, when they differ from `params`: once at rest, the column
+    /// settles again between the same walls under these (contact history cleared, as at the
+    /// release), so the deposit handed to the collapse is one that these laws hold.
+    pub relax: Option<DemParams>,
     /// Seed of the size draw and the lattice jitter.
     pub seed: u64,
     /// Rest criterion: deposition stops when the kinetic energy per grain falls below this
@@ -154,7 +159,7 @@ pub struct Column {
 /// Deposit a column by gravity to rest. Grains start on a square lattice of pitch 1.1 d_max
 /// filling the width, jittered by 0.05 d_max, with the floor at y = 0, and fall under
 /// `spec.params` (gravity included) until the kinetic energy per grain is below
-/// `rest_fraction`·m̄ g d̄.
+/// `rest_fraction`·m̄ g d̄; then, if `spec.relax` is given, settle to rest again under it.
 pub fn deposit_column(spec: &ColumnSpec) -> Result<Column> {
     let [d_min, d_max] = spec.diameter;
     if !(d_min > 0.0 && d_max >= d_min) {
@@ -189,31 +194,27 @@ pub fn deposit_column(spec: &ColumnSpec) -> Result<Column> {
     let gmag = spec.params.gravity[0].hypot(spec.params.gravity[1]);
     let mean_m = g.mass.iter().sum::<f64>() / g.len() as f64;
     let mean_d = 2.0 * g.radius.iter().sum::<f64>() / g.len() as f64;
-    let limit = spec.rest_fraction * mean_m * gmag * mean_d * g.len() as f64;
+    let rest = Rest {
+        kinetic: spec.rest_fraction * mean_m * gmag * mean_d * g.len() as f64,
+        check_time: 0.01 * (mean_d / gmag.max(f64::MIN_POSITIVE)).sqrt(),
+        max_time: spec.max_time,
+    };
+    // Free fall of the top row to the floor, before which no rest is accepted.
+    let fall = (2.0 * (spec.grains / per_row + 1) as f64 * pitch / gmag).sqrt();
     let mut dem = Dem::new(g, walls, spec.params.clone())?;
-    let check =
-        ((0.01 * (mean_d / gmag.max(f64::MIN_POSITIVE)).sqrt() / dem.dt()).ceil() as u64).max(1);
-    let mut rested = false;
-    while dem.time() < spec.max_time {
-        dem.steps(check);
-        let e = dem.energy();
-        if !e.kinetic_total().is_finite() {
-            return Err(Error::Other("deposition went unstable".into()));
-        }
-        if dem.time() > (2.0 * (spec.grains / per_row + 1) as f64 * pitch / gmag).sqrt()
-            && e.kinetic_total() < limit
-        {
-            rested = true;
-            break;
-        }
+    rest.settle(&mut dem, fall, "deposition")?;
+    let mut settle_time = dem.time();
+    if let Some(material) = &spec.relax {
+        let walls = dem.walls.clone();
+        dem = Dem::new(dem.grains, walls, material.clone())?;
+        dem.refresh_forces();
+        rest.settle(
+            &mut dem,
+            0.0,
+            "relaxation under the material's contact laws",
+        )?;
+        settle_time += dem.time();
     }
-    if !rested {
-        return Err(Error::Other(format!(
-            "deposition did not come to rest within {} s",
-            spec.max_time
-        )));
-    }
-    let settle_time = dem.time();
     let mut g = dem.grains;
     g.vx.iter_mut()
         .chain(g.vy.iter_mut())
@@ -234,6 +235,37 @@ pub fn deposit_column(spec: &ColumnSpec) -> Result<Column> {
         packing_fraction,
         settle_time,
     })
+}
+
+/// When a settling column counts as at rest.
+struct Rest {
+    /// Total kinetic energy below which the column is at rest (J).
+    kinetic: f64,
+    /// Interval between checks (s).
+    check_time: f64,
+    /// Give up after this simulated time (s).
+    max_time: f64,
+}
+
+impl Rest {
+    /// Step `dem` until its kinetic energy is below the limit, not before `min_time`.
+    fn settle(&self, dem: &mut Dem, min_time: f64, stage: &str) -> Result<()> {
+        let check = ((self.check_time / dem.dt()).ceil() as u64).max(1);
+        while dem.time() < self.max_time {
+            dem.steps(check);
+            let k = dem.energy().kinetic_total();
+            if !k.is_finite() {
+                return Err(Error::Other(format!("{stage} went unstable")));
+            }
+            if dem.time() > min_time && k < self.kinetic {
+                return Ok(());
+            }
+        }
+        Err(Error::Other(format!(
+            "{stage} did not come to rest within {} s",
+            self.max_time
+        )))
+    }
 }
 
 /// Convenience: contact parameters for deposition with friction `mu` (all else from `p`).

@@ -135,6 +135,11 @@ pub struct DepositionSpec {
     /// Grain–grain friction during deposition: 0 gives a dense column, ≈ the grain value a
     /// loose one.
     pub friction: f64,
+    /// Grain–grain rolling-friction cap μ_r during deposition (used where `rolling_stiffness`
+    /// is not 0): the grain value, or above it for a column looser than friction alone makes.
+    /// When either value differs from `grain_contact`, the deposit then settles again under
+    /// the grain laws before the release ([`ColumnSpec::relax`]).
+    pub rolling_friction: f64,
     /// Rest: kinetic energy per grain below this fraction of m̄ g d̄.
     pub rest_fraction: f64,
     /// Give up after this simulated time (s).
@@ -188,7 +193,7 @@ impl DemScenario {
     /// Check every value and derive the solver set-up. Refuses, naming the field: non-positive
     /// sizes, densities, stiffnesses or intervals; d_max < d_min; a column narrower than
     /// 4 d_max; a box not longer than the column; φ_est outside (0.5, 0.91); λ outside (0, 1];
-    /// deposition friction < 0; and (through [`crate::dem::Dem::new`] later) a step above
+    /// deposition friction or rolling friction < 0; and (through [`crate::dem::Dem::new`] later) a step above
     /// λ Δt_cr.
     pub fn derive(&self) -> Result<DerivedDem> {
         positive("gravity", self.gravity)?;
@@ -245,6 +250,12 @@ impl DemScenario {
                 format!("must be finite and ≥ 0, got {}", d.friction),
             ));
         }
+        if !(d.rolling_friction >= 0.0 && d.rolling_friction.is_finite()) {
+            return Err(Error::config(
+                "deposition.rolling_friction",
+                format!("must be finite and ≥ 0, got {}", d.rolling_friction),
+            ));
+        }
         positive("deposition.rest_fraction", d.rest_fraction)?;
         positive("deposition.max_time", d.max_time)?;
         let t = &self.time;
@@ -279,6 +290,8 @@ impl DemScenario {
         params.lambda = t.lambda;
         let mut dep = params.clone();
         dep.grain.friction = d.friction;
+        dep.grain.rolling_friction = d.rolling_friction;
+        let relax = (dep.grain != params.grain).then(|| params.clone());
         let column = ColumnSpec {
             x0: 0.0,
             width: c.width,
@@ -290,6 +303,7 @@ impl DemScenario {
             },
             density: g.density * g.thickness,
             params: dep,
+            relax,
             seed: self.seed,
             rest_fraction: d.rest_fraction,
             max_time: d.max_time,

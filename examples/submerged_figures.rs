@@ -1,14 +1,16 @@
 //! Figures of the submerged column collapse (docs/submerged.md) from run outputs.
 //!
-//! `cargo run --release --example submerged_figures -- RUNS FIGURES [TAG]` (TAG `a0.8` if not
-//! given, e.g. `a4`, `a0.8_wide`) reads `RUNS/{dry,loose,dense}_TAG/{timeseries.csv,summary.json}`
+//! `cargo run --release --example submerged_figures -- RUNS FIGURES [TAG [WINDOW]]` (TAG `a0.8`
+//! if not given, e.g. `a4`, `a0.8_wide`; WINDOW the end of the pore-pressure plot in τ_c, 12 if
+//! not given) reads `RUNS/{dry,loose,dense}_TAG/{timeseries.csv,summary.json}`
 //! and writes `FIGURES/submerged-TAG-pore-pressure.svg` (base excess pore pressure of the loose and
 //! dense columns over the buoyant weight (ρ_s − ρ_f) φ g H_i, against t/τ_c) and
 //! `FIGURES/submerged-TAG-runout.svg` ((L(t) − L_i)/L_i of all three), and prints one
 //! line per case: φ, ΔL, stop time, and the base pore pressure averaged over the first one and
 //! two acoustic periods T_a = 2 max(L_box, depth)/c_s of the tank (c_s = Δx/(√3 Δt)), in Pa
 //! and over the buoyant weight, and over (0, t_r], t_r = 2 min(depth, L_box − L_i)/c_s the
-//! time the first pressure wave reflected by the lid or the far wall needs to come back. The pore-pressure figure also shows its running mean over T_a.
+//! time the first pressure wave reflected by the lid or the far wall needs to come back, and over
+//! (0, t_½], t_½ when the run-out first reaches half its final value (the collapse itself). The pore-pressure figure also shows its running mean over T_a.
 
 use std::path::Path;
 
@@ -43,6 +45,9 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let (runs, figs) = (Path::new(&args[1]), Path::new(&args[2]));
     let tag = args.get(3).map_or("a0.8", String::as_str);
+    let window: f64 = args
+        .get(4)
+        .map_or(12.0, |w| w.parse().expect("WINDOW: a number"));
     std::fs::create_dir_all(figs).unwrap();
     let mut pore = Plot::new(
         &format!("submerged-{tag}-pore-pressure"),
@@ -57,7 +62,7 @@ fn main() {
         "(L(t) − L_i) / L_i",
     );
     pore.series
-        .push(Series::line("0", vec![(0.0, 0.0), (12.0, 0.0)]));
+        .push(Series::line("0", vec![(0.0, 0.0), (window, 0.0)]));
     let mut means = Vec::new();
     for case in ["dry", "loose", "dense"] {
         let dir = runs.join(format!("{case}_{tag}"));
@@ -100,7 +105,7 @@ fn main() {
             &format!("{label}, submerged"),
             c[0].iter()
                 .zip(&c[2])
-                .filter(|(&t, _)| t <= 12.0)
+                .filter(|(&t, _)| t <= window)
                 .map(|(&t, &p)| (t, p / scale))
                 .collect(),
         ));
@@ -131,6 +136,18 @@ fn main() {
             "{case}: t_r = {t_r:.2} τ_c; base pore pressure mean over (0, t_r] = {m0:.2} Pa ({:.4})",
             m0 / scale
         );
+        // While the column collapses: until the run-out first reaches half its final value.
+        let half = 0.5 * (summary["l_f"].as_f64().unwrap() + l_i);
+        let t_half = c[0]
+            .iter()
+            .zip(&c[1])
+            .find(|(_, &l)| l >= half)
+            .map_or(f64::NAN, |(&t, _)| t);
+        let mh = mean(0.0, t_half);
+        println!(
+            "{case}: half run-out at t_½ = {t_half:.2} τ_c; base pore pressure mean over (0, t_½] = {mh:.2} Pa ({:.4})",
+            mh / scale
+        );
         println!(
             "{case}: T_a = {t_a:.2} τ_c; base pore pressure mean over (0, T_a] = {m1:.2} Pa ({:.4} of (ρ_s − ρ_f)φgH_i = {scale:.1} Pa), over (0, 2T_a] = {m2:.2} Pa ({:.4})",
             m1 / scale,
@@ -139,7 +156,7 @@ fn main() {
         means.push((
             format!("{case}, running mean over T_a"),
             c[0].iter()
-                .filter(|&&t| t >= 0.5 * t_a && t <= 12.0 - 0.5 * t_a)
+                .filter(|&&t| t >= 0.5 * t_a && t <= window - 0.5 * t_a)
                 .map(|&t| (t, mean(t - 0.5 * t_a, t + 0.5 * t_a) / scale))
                 .collect::<Vec<_>>(),
         ));

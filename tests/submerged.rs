@@ -29,8 +29,8 @@ fn models() -> Vec<std::path::PathBuf> {
 #[test]
 fn every_submerged_model_checks() {
     let files = models();
-    // dry, loose, dense × (a = 0.8, 4) × (scaled, thesis).
-    assert_eq!(files.len(), 12, "{files:?}");
+    // dry, loose, dense × (a = 0.8, 4) × (scaled, thesis), and loose, dense a = 0.8 viscous.
+    assert_eq!(files.len(), 14, "{files:?}");
     for f in files {
         let text = std::fs::read_to_string(&f).unwrap();
         let name = f.file_name().unwrap().to_string_lossy().to_string();
@@ -42,8 +42,11 @@ fn every_submerged_model_checks() {
             let report = s.check_report().unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(report.ends_with("ok\n"), "{name}: {report}");
             // The dry file of the same a holds the same DEM part (same deposit).
-            let dry =
-                f.with_file_name(name.replacen("dense", "dry", 1).replacen("loose", "dry", 1));
+            let dry = f.with_file_name(
+                name.replacen("dense", "dry", 1)
+                    .replacen("loose", "dry", 1)
+                    .replacen("_viscous", "", 1),
+            );
             let d = DemScenario::from_file(&dry).unwrap();
             assert_eq!(s.grains.d_min, d.grains.d_min, "{name}");
             assert_eq!(s.column.width, d.column.width, "{name}");

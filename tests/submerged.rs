@@ -29,8 +29,9 @@ fn models() -> Vec<std::path::PathBuf> {
 #[test]
 fn every_submerged_model_checks() {
     let files = models();
-    // dry, loose, dense × (a = 0.8, 4) × (scaled, thesis), and loose, dense a = 0.8 viscous.
-    assert_eq!(files.len(), 14, "{files:?}");
+    // dry, loose, dense × (a = 0.8, 4) × (scaled, thesis), and loose, dense × (a = 0.8, 4)
+    // viscous.
+    assert_eq!(files.len(), 16, "{files:?}");
     for f in files {
         let text = std::fs::read_to_string(&f).unwrap();
         let name = f.file_name().unwrap().to_string_lossy().to_string();

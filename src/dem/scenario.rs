@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 use super::contact::ContactParams;
 use super::packing::{ColumnSpec, SizeDistribution};
 use super::solver::DemParams;
-use crate::config::positive;
+use crate::config::{non_negative, positive};
 use crate::{Error, Result};
 
 /// A DEM column-collapse scenario, as read from TOML. All values SI.
@@ -193,8 +193,8 @@ impl DemScenario {
     /// Check every value and derive the solver set-up. Refuses, naming the field: non-positive
     /// sizes, densities, stiffnesses or intervals; d_max < d_min; a column narrower than
     /// 4 d_max; a box not longer than the column; φ_est outside (0.5, 0.91); λ outside (0, 1];
-    /// deposition friction or rolling friction < 0; and (through [`crate::dem::Dem::new`] later) a step above
-    /// λ Δt_cr.
+    /// deposition friction or rolling friction < 0; and (through [`crate::dem::Dem::new`]
+    /// later) a step above λ Δt_cr.
     pub fn derive(&self) -> Result<DerivedDem> {
         positive("gravity", self.gravity)?;
         let g = &self.grains;
@@ -244,18 +244,8 @@ impl DemScenario {
         grain.check("grain_contact")?;
         wall.check("wall_contact")?;
         let d = &self.deposition;
-        if !(d.friction >= 0.0 && d.friction.is_finite()) {
-            return Err(Error::config(
-                "deposition.friction",
-                format!("must be finite and ≥ 0, got {}", d.friction),
-            ));
-        }
-        if !(d.rolling_friction >= 0.0 && d.rolling_friction.is_finite()) {
-            return Err(Error::config(
-                "deposition.rolling_friction",
-                format!("must be finite and ≥ 0, got {}", d.rolling_friction),
-            ));
-        }
+        non_negative("deposition.friction", d.friction)?;
+        non_negative("deposition.rolling_friction", d.rolling_friction)?;
         positive("deposition.rest_fraction", d.rest_fraction)?;
         positive("deposition.max_time", d.max_time)?;
         let t = &self.time;

@@ -16,7 +16,7 @@
 
 use rayon::prelude::*;
 
-use super::overlap::disk_rect;
+use super::overlap::DiskCells;
 use crate::dem::scale::GrainView;
 use crate::dem::ExternalLoads;
 use crate::lbm::{CellForces, SolidCover};
@@ -24,7 +24,11 @@ use crate::lbm::{CellForces, SolidCover};
 /// Grains per parallel chunk of the rasterisation.
 const GRAIN_CHUNK: usize = 64;
 /// Lattice rows per band of the parallel per-cell pass.
-const BAND_ROWS: usize = 32;
+const BAND_ROWS: usize = 8;
+/// Bands per group: a group sums its bands one after another in one accumulator, which so
+/// stays in cache (a dense accumulator over the whole lattice was re-read from memory every
+/// step).
+const GROUP_BANDS: usize = 8;
 
 /// The lattice the disks are drawn on.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -56,8 +60,8 @@ struct Piece {
 ///
 /// Everything runs in parallel without locks: the overlaps are computed per chunk of
 /// [`GRAIN_CHUNK`] grains and filed by band of [`BAND_ROWS`] lattice rows
-/// (`pieces[chunk × bands + band]`); the per-cell sums then run per band (a band owns its
-/// cells), and the force sums per chunk (a chunk owns its grains). Within a cell the pieces
+/// (`pieces[chunk × bands + band]`); the per-cell sums then run per group of
+/// [`GROUP_BANDS`] bands (a band owns its cells), and the force sums per chunk (a chunk owns its grains). Within a cell the pieces
 /// are summed in grain order, and within a grain in band order, whatever the thread count.
 #[derive(Clone, Debug)]
 pub struct DiskCover {
@@ -68,10 +72,11 @@ pub struct DiskCover {
     /// Overlaps of each chunk of [`GRAIN_CHUNK`] grains in each band of [`BAND_ROWS`] rows,
     /// at `chunk × bands + band`.
     pieces: Vec<Vec<Piece>>,
-    /// Cells each band touched in the last cover (ascending).
-    band_cells: Vec<Vec<u32>>,
-    /// Σ_k ε_nk, Σ_k ε_nk u_x, Σ_k ε_nk u_y per cell (dense; zero outside the cover).
-    acc: Vec<[f64; 3]>,
+    /// The cells each band covered in the last cover, with their sums.
+    bands: Vec<BandCells>,
+    /// Per group of [`GROUP_BANDS`] bands, Σ_k ε_nk, Σ_k ε_nk u_x, Σ_k ε_nk u_y over the cells
+    /// of one band (zero between uses).
+    acc: Vec<Vec<[f64; 3]>>,
     /// Cover slot of each cell (dense; valid for covered cells).
     slot_of: Vec<u32>,
     /// Σ_k ε_nk per cover slot (unclipped).
@@ -90,12 +95,13 @@ impl DiskCover {
             ));
         }
         let n = grid.nx * grid.ny;
+        let bands = grid.ny.div_ceil(BAND_ROWS);
         Ok(DiskCover {
             grid,
             radius_factor,
             pieces: Vec::new(),
-            band_cells: vec![Vec::new(); grid.ny.div_ceil(BAND_ROWS)],
-            acc: vec![[0.0; 3]; n],
+            bands: vec![BandCells::default(); bands],
+            acc: vec![vec![[0.0; 3]; BAND_ROWS * grid.nx]; bands.div_ceil(GROUP_BANDS)],
             slot_of: vec![u32::MAX; n],
             total: Vec::new(),
             grains: 0,
@@ -112,7 +118,7 @@ impl DiskCover {
         } = self.grid;
         self.grains = g.x.len();
         let chunks = g.x.len().div_ceil(GRAIN_CHUNK);
-        let bands = self.band_cells.len();
+        let bands = self.bands.len();
         if self.pieces.len() < chunks * bands {
             self.pieces.resize_with(chunks * bands, Vec::new);
         }
@@ -123,12 +129,14 @@ impl DiskCover {
             .enumerate()
             .for_each(|(ch, bufs)| {
                 bufs.iter_mut().for_each(Vec::clear);
+                let mut disk = DiskCells::default();
                 let k1 = ((ch + 1) * GRAIN_CHUNK).min(g.x.len());
                 for k in ch * GRAIN_CHUNK..k1 {
                     let r = kappa * g.radius[k] / dx;
                     let (cx, cy) = (g.x[k] / dx, g.y[k] / dx);
                     let (i0, i1) = ((cx - r).floor() as i64, (cx + r).floor() as i64);
                     let (j0, j1) = ((cy - r).floor() as i64, (cy + r).floor() as i64);
+                    disk.set([cx, cy], r, [i0, i1], [j0, j1]);
                     for j in j0..=j1 {
                         let Some(jj) = wrap(j, ny, periodic[1]) else {
                             continue;
@@ -139,7 +147,7 @@ impl DiskCover {
                                 continue;
                             };
                             let (x, y) = (i as f64, j as f64);
-                            let eps = disk_rect([cx, cy], r, x, x + 1.0, y, y + 1.0);
+                            let eps = disk.area(i, j);
                             if eps > 0.0 {
                                 buf.push(Piece {
                                     cell: (jj * nx + ii) as u32,
@@ -152,43 +160,43 @@ impl DiskCover {
                     }
                 }
             });
-        // Per band: sum the pieces per cell (grains may share cells), list the touched cells
-        // in ascending order (sorted, or by a scan of the band when they are many).
+        // Per band: sum the pieces per cell (grains may share cells), then list the covered
+        // cells in ascending order by a scan of the band, clearing the accumulator.
         let band_len = BAND_ROWS * nx;
         let pieces = &self.pieces;
-        self.acc
-            .par_chunks_mut(band_len)
-            .zip(self.band_cells.par_iter_mut())
+        self.bands
+            .par_chunks_mut(GROUP_BANDS)
+            .zip(self.acc.par_iter_mut())
             .enumerate()
-            .for_each(|(b, (acc, touched))| {
-                touched.clear();
-                let c0 = b * band_len;
-                for ch in 0..chunks {
-                    for p in &pieces[ch * bands + b] {
-                        let k = p.grain as usize;
-                        let w = g.omega[k];
-                        let a = &mut acc[p.cell as usize - c0];
-                        if a[0] == 0.0 {
-                            touched.push(p.cell);
-                        }
-                        a[0] += p.eps;
-                        a[1] += p.eps * (g.vx[k] - w * p.r[1]);
-                        a[2] += p.eps * (g.vy[k] + w * p.r[0]);
+            .for_each(|(group, (out, acc))| {
+                for (i, band) in out.iter_mut().enumerate() {
+                    band.clear();
+                    let b = group * GROUP_BANDS + i;
+                    if (0..chunks).all(|ch| pieces[ch * bands + b].is_empty()) {
+                        continue;
                     }
-                }
-                if touched.len() * 16 > acc.len() {
-                    touched.clear();
-                    touched.extend(
-                        (0..acc.len())
-                            .filter(|&c| acc[c][0] > 0.0)
-                            .map(|c| (c0 + c) as u32),
-                    );
-                } else {
-                    touched.sort_unstable();
+                    let c0 = b * band_len;
+                    for ch in 0..chunks {
+                        for p in &pieces[ch * bands + b] {
+                            let k = p.grain as usize;
+                            let w = g.omega[k];
+                            let a = &mut acc[p.cell as usize - c0];
+                            a[0] += p.eps;
+                            a[1] += p.eps * (g.vx[k] - w * p.r[1]);
+                            a[2] += p.eps * (g.vy[k] + w * p.r[0]);
+                        }
+                    }
+                    let len = band_len.min(nx * ny - c0);
+                    for (c, a) in acc[..len].iter_mut().enumerate() {
+                        if a[0] > 0.0 {
+                            band.push((c0 + c) as u32, *a);
+                            *a = [0.0; 3];
+                        }
+                    }
                 }
             });
         // Output: each band fills its slice of the cover (offsets from the band counts).
-        let total: usize = self.band_cells.iter().map(Vec::len).sum();
+        let total: usize = self.bands.iter().map(|b| b.cells.len()).sum();
         out.cells.resize(total, 0);
         out.eps.resize(total, 0.0);
         out.ux.resize(total, 0.0);
@@ -203,8 +211,8 @@ impl DiskCover {
             &mut self.total[..],
         );
         let mut offset = 0;
-        for t in &self.band_cells {
-            let n = t.len();
+        for band in &self.bands {
+            let n = band.cells.len();
             let (c, rc) = std::mem::take(&mut cells).split_at_mut(n);
             let (e, re) = std::mem::take(&mut eps).split_at_mut(n);
             let (x, rx) = std::mem::take(&mut ux).split_at_mut(n);
@@ -214,23 +222,20 @@ impl DiskCover {
             (cells, eps, ux, uy, tot) = (rc, re, rx, ry, rs);
             offset += n;
         }
-        self.acc
+        self.slot_of
             .par_chunks_mut(band_len)
-            .zip(self.slot_of.par_chunks_mut(band_len))
-            .zip(self.band_cells.par_iter())
+            .zip(self.bands.par_iter())
             .zip(slices.into_par_iter())
             .enumerate()
-            .for_each(|(b, (((acc, slot_of), touched), (off, c, e, x, y, s)))| {
+            .for_each(|(b, ((slot_of, band), (off, c, e, x, y, s)))| {
                 let c0 = b * band_len;
-                for (k, &cell) in touched.iter().enumerate() {
-                    let a = &mut acc[cell as usize - c0];
+                c.copy_from_slice(&band.cells);
+                x.copy_from_slice(&band.ux);
+                y.copy_from_slice(&band.uy);
+                s.copy_from_slice(&band.total);
+                for (k, (&cell, &t)) in band.cells.iter().zip(&band.total).enumerate() {
                     slot_of[cell as usize - c0] = (off + k) as u32;
-                    c[k] = cell;
-                    e[k] = a[0].min(1.0);
-                    x[k] = a[1] / a[0];
-                    y[k] = a[2] / a[0];
-                    s[k] = a[0];
-                    *a = [0.0; 3];
+                    e[k] = t.min(1.0);
                 }
             });
     }
@@ -252,7 +257,7 @@ impl DiskCover {
             return;
         }
         // Per chunk of grains (a chunk owns its grains and their pieces).
-        let bands = self.band_cells.len();
+        let bands = self.bands.len();
         let chunks = self.grains.div_ceil(GRAIN_CHUNK);
         let (slot_of, total) = (&self.slot_of, &self.total);
         self.pieces[..chunks * bands]
@@ -273,6 +278,33 @@ impl DiskCover {
                     lt[k] += p.r[0] * fy - p.r[1] * fx;
                 }
             });
+    }
+}
+
+/// The covered cells of one band, ascending: Σ_k ε_nk and the solid velocity
+/// Σ_k ε_nk u_nk / Σ_k ε_nk.
+#[derive(Clone, Debug, Default)]
+struct BandCells {
+    cells: Vec<u32>,
+    total: Vec<f64>,
+    ux: Vec<f64>,
+    uy: Vec<f64>,
+}
+
+impl BandCells {
+    fn clear(&mut self) {
+        self.cells.clear();
+        self.total.clear();
+        self.ux.clear();
+        self.uy.clear();
+    }
+
+    /// Add cell `cell` from its sums [Σ ε, Σ ε u_x, Σ ε u_y].
+    fn push(&mut self, cell: u32, a: [f64; 3]) {
+        self.cells.push(cell);
+        self.total.push(a[0]);
+        self.ux.push(a[1] / a[0]);
+        self.uy.push(a[2] / a[0]);
     }
 }
 

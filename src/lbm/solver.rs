@@ -76,7 +76,8 @@ pub struct Lbm<T> {
     /// Cells partially covered by moving solids (empty: a plain fluid).
     pub partial: PartialCells<T>,
     /// Momentum exchanged per covered cell summed over the steps of the last
-    /// [`Scale::advance`], and their number.
+    /// [`Scale::advance`], and their number (the sum is kept only for more than one step;
+    /// for one, [`PartialCells::exchange`] is that step's).
     exchange_sum: (Vec<[f64; 2]>, u64),
     /// Boundary links of moving solids under Ladd's bounce-back (empty: none).
     pub ladd: BounceLinks,
@@ -139,21 +140,30 @@ impl<T: Real> Lbm<T> {
     pub fn set_cover(&mut self, cover: &SolidCover) {
         use rayon::prelude::*;
         let p = &mut self.partial;
-        p.clear();
-        let (tau, units) = (self.collider.tau, &self.units);
+        let (tau, units, n) = (self.collider.tau, &self.units, cover.cells.len());
+        p.cells.clear();
         p.cells.extend_from_slice(&cover.cells);
-        p.b.par_extend(
-            cover
-                .eps
-                .par_iter()
-                .map(|&e| T::c(partial::weighting(e, tau))),
-        );
-        let lattice_velocity = |v: &Vec<f64>, out: &mut Vec<T>| {
-            out.par_extend(v.par_iter().map(|&u| T::c(units.velocity_to_lattice(u))));
-        };
-        lattice_velocity(&cover.ux, &mut p.ux);
-        lattice_velocity(&cover.uy, &mut p.uy);
-        p.exchange.resize(cover.cells.len(), [0.0; 2]);
+        // Resized (a cover changes little between steps), then overwritten in one pass.
+        p.b.resize(n, T::zero());
+        p.ux.resize(n, T::zero());
+        p.uy.resize(n, T::zero());
+        p.exchange.resize(n, [0.0; 2]);
+        (
+            &mut p.b,
+            &mut p.ux,
+            &mut p.uy,
+            &mut p.exchange,
+            &cover.eps,
+            &cover.ux,
+            &cover.uy,
+        )
+            .into_par_iter()
+            .for_each(|(b, ux, uy, ex, &e, &vx, &vy)| {
+                *b = T::c(partial::weighting(e, tau));
+                *ux = T::c(units.velocity_to_lattice(vx));
+                *uy = T::c(units.velocity_to_lattice(vy));
+                *ex = [0.0; 2];
+            });
     }
 
     /// Total fluid momentum Σ_cells Σ_i f_i e_i (lattice units, pre-collision, without the
@@ -333,36 +343,42 @@ impl<T: Real> Scale for Lbm<T> {
         if !(input.links.is_empty() && self.ladd.is_empty()) {
             self.ladd.set(&mut self.lattice, &input.links, &self.units);
         }
+        let steps = k as u64;
         let (sum, count) = &mut self.exchange_sum;
         sum.clear();
-        sum.resize(input.cells.len(), [0.0; 2]);
-        *count = 0;
-        for _ in 0..k as u64 {
+        if steps > 1 {
+            sum.resize(input.cells.len(), [0.0; 2]);
+        }
+        *count = steps;
+        for _ in 0..steps {
             self.step();
-            let (sum, count) = &mut self.exchange_sum;
-            use rayon::prelude::*;
-            sum.par_iter_mut()
-                .zip(self.partial.exchange.par_iter())
-                .for_each(|(s, e)| {
-                    s[0] += e[0];
-                    s[1] += e[1];
-                });
-            *count += 1;
+            if steps > 1 {
+                use rayon::prelude::*;
+                self.exchange_sum
+                    .0
+                    .par_iter_mut()
+                    .zip(self.partial.exchange.par_iter())
+                    .for_each(|(s, e)| {
+                        s[0] += e[0];
+                        s[1] += e[1];
+                    });
+            }
         }
         Ok(())
     }
     /// Force on the solid per covered cell, F = −Δp (N/m), seed eq. 5.53.
     fn observe(&self, out: &mut CellForces) {
-        let (sum, count) = &self.exchange_sum;
-        let k = (*count).max(1) as f64;
+        // One step: its own exchange; several: their sum.
+        let (sum, count) = match self.exchange_sum {
+            (_, 0 | 1) => (&self.partial.exchange, 1),
+            (ref sum, k) => (sum, k),
+        };
+        let k = count as f64;
         use rayon::prelude::*;
         let u = &self.units;
-        out.fx.clear();
-        out.fy.clear();
-        out.fx
-            .par_extend(sum.par_iter().map(|s| -u.force_to_si(s[0] / k)));
-        out.fy
-            .par_extend(sum.par_iter().map(|s| -u.force_to_si(s[1] / k)));
+        sum.par_iter()
+            .map(|s| (-u.force_to_si(s[0] / k), -u.force_to_si(s[1] / k)))
+            .unzip_into_vecs(&mut out.fx, &mut out.fy);
         self.ladd.observe(&self.units, &mut out.links);
     }
     fn snapshot(&self) -> LbmSnapshot<T> {

@@ -55,14 +55,16 @@ struct Piece {
 
 /// Rasterises disks as partially saturated cells and sums cell forces per grain.
 ///
-/// Per-cell sums live in dense arrays over the lattice (reset cell by cell after use), so a
-/// step allocates nothing once the buffers have grown and needs no sort of the pieces.
+/// Per-cell sums are accumulated in one band-sized array per group of [`GROUP_BANDS`] bands
+/// (cleared as the band's covered cells are read out), so a step allocates nothing once the
+/// buffers have grown and needs no sort of the pieces.
 ///
 /// Everything runs in parallel without locks: the overlaps are computed per chunk of
 /// [`GRAIN_CHUNK`] grains and filed by band of [`BAND_ROWS`] lattice rows
-/// (`pieces[chunk × bands + band]`); the per-cell sums then run per group of
-/// [`GROUP_BANDS`] bands (a band owns its cells), and the force sums per chunk (a chunk owns its grains). Within a cell the pieces
-/// are summed in grain order, and within a grain in band order, whatever the thread count.
+/// (`pieces[chunk × bands + band]`); the per-cell sums then run per group of bands (a band
+/// owns its cells), and the force sums per chunk (a chunk owns its grains). Within a cell the
+/// pieces are summed in grain order, and within a grain in band order, whatever the thread
+/// count.
 #[derive(Clone, Debug)]
 pub struct DiskCover {
     /// The lattice.

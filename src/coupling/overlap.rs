@@ -81,7 +81,6 @@ struct RowEdge {
 /// per cell. [`DiskCells::area`] is bit for bit [`disk_rect`] of the same cell.
 #[derive(Clone, Debug, Default)]
 pub struct DiskCells {
-    c: [f64; 2],
     r: f64,
     i0: i64,
     j0: i64,
@@ -97,7 +96,6 @@ impl DiskCells {
     /// Prepare the cells i0 ..= i1, j0 ..= j1 of the disk (centre `c`, radius `r`, in cell
     /// units); keeps the buffers.
     pub fn set(&mut self, c: [f64; 2], r: f64, [i0, i1]: [i64; 2], [j0, j1]: [i64; 2]) {
-        self.c = c;
         self.r = r;
         self.i0 = i0;
         self.j0 = j0;

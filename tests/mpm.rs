@@ -98,23 +98,26 @@ fn bad_scenarios_are_refused_naming_the_field() {
     assert!(e.contains("time.dt"), "{e}");
     let s = MpmScenario::from_toml(&text.replace("[time]\n", "[time]\ndt = 1.0e-6\n")).unwrap();
     assert_eq!(s.build().unwrap().0.dt(), 1e-6);
-    // The velocity transfer: APIC is taken from the file, and refused with a PIC fraction or
-    // with standard shape functions, naming the field, before anything is built.
-    let apic = text.replace("transfer = \"flip\"", "transfer = \"apic\"");
-    let s = MpmScenario::from_toml(&apic.replace("pic_fraction = 0.005", "pic_fraction = 0.0"))
-        .unwrap();
+    // The velocity transfer is taken from the file (APIC in the collapse models, FLIP with a
+    // PIC fraction on request); APIC is refused with a PIC fraction or with standard shape
+    // functions, naming the field, before anything is built.
+    assert!(text.contains("transfer = \"apic\"\npic_fraction = 0.0\n"));
+    let s = MpmScenario::from_toml(&text).unwrap();
     assert_eq!(s.build().unwrap().0.transfer(), Transfer::Apic);
-    let e = MpmScenario::from_toml(&apic).unwrap().derive().unwrap_err();
+    let flip = text.replace("transfer = \"apic\"", "transfer = \"flip\"");
+    let s = MpmScenario::from_toml(&flip.replace("pic_fraction = 0.0", "pic_fraction = 0.005"))
+        .unwrap();
+    assert_eq!(s.build().unwrap().0.transfer(), Transfer::Flip);
+    let with_pic = text.replace("pic_fraction = 0.0", "pic_fraction = 0.005");
+    let e = MpmScenario::from_toml(&with_pic).unwrap().derive().unwrap_err();
     assert!(e.to_string().contains("mpm.pic_fraction"), "{e}");
-    let std_apic = apic
-        .replace("pic_fraction = 0.005", "pic_fraction = 0.0")
-        .replace("shape = \"gimp\"", "shape = \"standard\"");
+    let std_apic = text.replace("shape = \"gimp\"", "shape = \"standard\"");
     let e = MpmScenario::from_toml(&std_apic)
         .unwrap()
         .derive()
         .unwrap_err();
     assert!(e.to_string().contains("mpm.transfer"), "{e}");
-    let e = MpmScenario::from_toml(&text.replace("transfer = \"flip\"\n", ""))
+    let e = MpmScenario::from_toml(&text.replace("transfer = \"apic\"\n", ""))
         .unwrap_err()
         .to_string();
     assert!(e.contains("transfer"), "{e}");

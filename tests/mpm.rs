@@ -109,7 +109,10 @@ fn bad_scenarios_are_refused_naming_the_field() {
         .unwrap();
     assert_eq!(s.build().unwrap().0.transfer(), Transfer::Flip);
     let with_pic = text.replace("pic_fraction = 0.0", "pic_fraction = 0.005");
-    let e = MpmScenario::from_toml(&with_pic).unwrap().derive().unwrap_err();
+    let e = MpmScenario::from_toml(&with_pic)
+        .unwrap()
+        .derive()
+        .unwrap_err();
     assert!(e.to_string().contains("mpm.pic_fraction"), "{e}");
     let std_apic = text.replace("shape = \"gimp\"", "shape = \"standard\"");
     let e = MpmScenario::from_toml(&std_apic)

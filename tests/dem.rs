@@ -387,3 +387,81 @@ fn grains_passing_through_each_other_stop_the_run() {
         "{err}"
     );
 }
+
+/// A floor moving up at constant speed u under a disk (gravity g): in the steady state the
+/// disk moves with the floor and its contact carries exactly its weight with a still
+/// dashpot, so δ = m g/k_n (to 1e-9 relative after the e = 0.5 bounce has decayed). A wall
+/// taken as at rest would see the disk recede at u and hold δ = (m g + c_n u)/k_n, 9.8 times
+/// as much here. The floor starts 3 skins below the disk, so reaching it needs the list rebuilds that
+/// a moving wall triggers.
+#[test]
+fn moving_floor_lifts_a_disk_with_a_still_dashpot() {
+    let (k, r, m, g, u) = (1e4, 0.01, 0.01, 9.81, 0.2);
+    let law = ContactParams {
+        restitution: 0.5,
+        ..ContactParams::elastic(k)
+    };
+    let mut grains = Grains::new();
+    grains.push(0.0, r, r, m);
+    let mut dem = Dem::new(
+        grains,
+        vec![Wall::floor(-0.012)],
+        DemParams::new(law, law, [0.0, -g]),
+    )
+    .unwrap();
+    dem.grains.vy[0] = 0.0;
+    dem.set_wall_velocity(0, [0.0, u]).unwrap();
+    dem.advance_with(0.5, None).unwrap();
+    let Wall::Plane { point, .. } = dem.walls[0] else {
+        unreachable!()
+    };
+    assert!((point[1] - (-0.012 + u * dem.time())).abs() < 1e-12);
+    let floor = point[1];
+    let delta = r - (dem.grains.y[0] - floor);
+    assert!(
+        (dem.grains.vy[0] / u - 1.0).abs() < 1e-9,
+        "{}",
+        dem.grains.vy[0]
+    );
+    assert!(
+        (delta * k / (m * g) - 1.0).abs() < 1e-9,
+        "δ k/(m g) = {}",
+        delta * k / (m * g)
+    );
+    assert!(dem.set_wall_velocity(1, [0.0; 2]).is_err());
+}
+
+/// A disk at rest on a conveyor floor moving at u (no rolling resistance): friction acts at
+/// the contact only, so J ω − R m v stays 0 (ω R = 2 v for J = ½ m R², to round-off) and
+/// sliding stops when the contact point moves with the belt, v + ω R = u, i.e. v = u/3 —
+/// checked to 1 % after a tangential dashpot has damped the stick oscillation. With the floor
+/// taken as at rest the disk would not move at all.
+#[test]
+fn conveyor_floor_drags_a_disk_to_a_third_of_its_speed() {
+    let (k, r, rho, g, u) = (1e4, 0.01, 1.0, 9.81, 0.05);
+    let law = ContactParams {
+        k_t: 0.5 * k,
+        restitution: 0.5,
+        gamma_t: 200.0,
+        friction: 0.3,
+        ..ContactParams::elastic(k)
+    };
+    let mut grains = Grains::new();
+    grains.push_disk(0.0, r, r, rho);
+    let mut dem = Dem::new(
+        grains,
+        vec![Wall::floor(0.0)],
+        DemParams::new(law, law, [0.0, -g]),
+    )
+    .unwrap();
+    dem.advance_with(0.05, None).unwrap();
+    dem.set_wall_velocity(0, [u, 0.0]).unwrap();
+    dem.advance_with(1.0, None).unwrap();
+    let (v, w) = (dem.grains.vx[0], dem.grains.omega[0]);
+    assert!((v / (u / 3.0) - 1.0).abs() < 0.01, "v/u = {}", v / u);
+    assert!(
+        (w * r / (2.0 * v) - 1.0).abs() < 1e-9,
+        "ωR/2v = {}",
+        w * r / (2.0 * v)
+    );
+}

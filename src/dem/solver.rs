@@ -272,6 +272,10 @@ pub struct Dem {
     /// Pairs the cell list does not handle (polygon grains, polygon walls), through rapier;
     /// `None` for an all-disk system with straight walls.
     shapes: Option<ShapeContacts>,
+    /// Velocity of each wall (m/s), empty while all are at rest ([`Dem::set_wall_velocity`]).
+    wall_velocity: Vec<[f64; 2]>,
+    /// Largest distance a wall has translated since the last list build (m).
+    wall_travel: f64,
 }
 
 impl Dem {
@@ -385,7 +389,51 @@ impl Dem {
             contacts: 0,
             deepest: Overlap::default(),
             contact_steps: 0,
+            wall_velocity: Vec::new(),
+            wall_travel: 0.0,
         })
+    }
+
+    /// Let wall `k` translate at velocity `v` (m/s) from now on: at every step it moves by
+    /// **v** Δt, and its contacts see the relative velocity of grain and wall (the normal and
+    /// tangential dashpots and the tangential spring use **v**_grain − **v**). Plane and
+    /// segment walls of an all-disk system only. The walls' work on the grains is not booked
+    /// in [`Energy::work_external`], so the budget of a system with a moving wall does not close.
+    pub fn set_wall_velocity(&mut self, k: usize, v: [f64; 2]) -> Result<()> {
+        let field = format!("dem.walls[{k}]");
+        let Some(w) = self.walls.get(k) else {
+            return Err(Error::config(field, "no such wall"));
+        };
+        if !w.is_straight() || self.shapes.is_some() {
+            return Err(Error::config(
+                field,
+                "only plane and segment walls of an all-disk system can move",
+            ));
+        }
+        if !v.iter().all(|c| c.is_finite()) {
+            return Err(Error::config(field, "wall velocity must be finite"));
+        }
+        self.wall_velocity.resize(self.walls.len(), [0.0; 2]);
+        self.wall_velocity[k] = v;
+        Ok(())
+    }
+
+    /// Translate the moving walls by **v** `dt`; once one has gone skin/2 since the last
+    /// list build, the lists are rebuilt before the next force evaluation (grains and walls
+    /// then together moved less than the skin, so no contact is missed).
+    fn move_walls(&mut self, dt: f64) {
+        if self.wall_velocity.is_empty() {
+            return;
+        }
+        let mut fastest: f64 = 0.0;
+        for (w, v) in self.walls.iter_mut().zip(&self.wall_velocity) {
+            w.translate([v[0] * dt, v[1] * dt]);
+            fastest = fastest.max(v[0].hypot(v[1]));
+        }
+        self.wall_travel += fastest * dt;
+        if self.wall_travel > 0.5 * self.detector.skin {
+            self.moved = true;
+        }
     }
 
     /// The time step Δt in use (s).
@@ -574,6 +622,7 @@ impl Dem {
         }
         self.kick_drift(dt);
         for k in 1..=n {
+            self.move_walls(dt);
             let fused = k < n && self.shapes.is_none();
             self.compute_forces(dt, loads, 0.5 * dt, fused.then_some(dt));
             if !fused {
@@ -662,6 +711,7 @@ impl Dem {
     ) {
         if self.moved {
             self.moved = false;
+            self.wall_travel = 0.0;
             self.detector.build(
                 &self.grains,
                 &self.walls,
@@ -692,6 +742,7 @@ impl Dem {
         let (rad, m) = (&g.radius[..], &g.mass[..]);
         let (vxp, vyp, wp) = (&self.vxp[..], &self.vyp[..], &self.wp[..]);
         let (law, wlaw, walls) = (self.grain_law, self.wall_law, &self.walls);
+        let wall_v = &self.wall_velocity[..];
         let pl = &mut self.pairs;
         let wl = &mut self.wall_pairs;
         let (pi, pj, first) = (&pl.i[..], &pl.j[..], &pl.first[..]);
@@ -835,21 +886,21 @@ impl Dem {
             }
             let (wstate, w0) = (s.wstate, s.w0);
             for k in 0..wstate.len() {
-                let i = wg[w0 + k] as usize;
-                let (dist, [nx, ny]) = walls[ww[w0 + k] as usize].distance([x[i], y[i]]);
+                let (i, wi) = (wg[w0 + k] as usize, ww[w0 + k] as usize);
+                let (dist, [nx, ny]) = walls[wi].distance([x[i], y[i]]);
                 let ri = rad[i];
                 if dist >= ri && !wstate[k].touching() {
                     continue;
                 }
                 let (tx, ty) = (-ny, nx);
                 let (w, w1) = (om[i], wp[i]);
+                // Velocities relative to the wall (at rest unless it was set moving).
+                let [ux, uy] = wall_v.get(wi).copied().unwrap_or([0.0; 2]);
+                let (rx, ry, rxp, ryp) = (vx[i] - ux, vy[i] - uy, vxp[i] - ux, vyp[i] - uy);
                 let motion = Motion {
                     delta: ri - dist,
-                    u: [vx[i] * nx + vy[i] * ny, vxp[i] * nx + vyp[i] * ny],
-                    v_t: [
-                        vx[i] * tx + vy[i] * ty + w * ri,
-                        vxp[i] * tx + vyp[i] * ty + w1 * ri,
-                    ],
+                    u: [rx * nx + ry * ny, rxp * nx + ryp * ny],
+                    v_t: [rx * tx + ry * ty + w * ri, rxp * tx + ryp * ty + w1 * ri],
                     w: [w, w1],
                     m_eff: m[i],
                     r_eff: ri,

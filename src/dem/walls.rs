@@ -91,6 +91,22 @@ impl Wall {
         })
     }
 
+    /// Move the wall by `d` (m), keeping its orientation.
+    pub fn translate(&mut self, d: [f64; 2]) {
+        let shift = |p: &mut [f64; 2]| {
+            p[0] += d[0];
+            p[1] += d[1];
+        };
+        match self {
+            Wall::Plane { point, .. } => shift(point),
+            Wall::Segment { a, b } => {
+                shift(a);
+                shift(b);
+            }
+            Wall::Polygon { vertices, n } => vertices[..*n as usize].iter_mut().for_each(shift),
+        }
+    }
+
     /// Whether the cell list handles this wall for disks (planes and segments).
     pub fn is_straight(&self) -> bool {
         !matches!(self, Wall::Polygon { .. })

@@ -1,6 +1,7 @@
 //! Discrete element method for disks and convex polygons (seed eq. 5.55–5.61).
 //!
 //! * [`bench`]: the `granflow bench dem` case (LAMMPS `in.gran2d.lmp`);
+//! * [`biaxial`]: biaxial compression of a packing, the material's friction angle;
 //! * [`grains`]: the grains (disks or convex polygons) as a structure of arrays;
 //! * [`shape`]: the shared polygon table and polygon mass properties;
 //! * [`contact`]: the contact law (linear spring-dashpot normal force with the damping set by a
@@ -22,6 +23,7 @@
 //! * [`run`]: the column-collapse runner (VTK series, time series, summary).
 
 pub mod bench;
+pub mod biaxial;
 pub mod contact;
 pub mod detect_rapier;
 pub mod energy;

@@ -41,6 +41,8 @@ use crate::io::plot::write_svg;
 use crate::validate::{Plot, Series};
 use crate::{Error, Result};
 
+/// Largest inertial number of the consolidation's wall speeds.
+const CONSOLIDATION_INERTIAL_NUMBER: f64 = 1e-3;
 /// Recorded points in the running mean whose largest value is the peak.
 pub const PEAK_POINTS: usize = 5;
 /// Steps between two piston updates.
@@ -453,9 +455,11 @@ pub fn run_biaxial(spec: &BiaxialSpec, progress: crate::run::Progress) -> Result
         piston: [Piston::default(); 2],
     };
     // Consolidation: the lid starts at the top of the deposit, a fraction of a grain away at
-    // most, so the walls need not travel far; their speed is capped at the shear's.
-    let lid_speed = strain_rate * column.height;
-    let v_max = lid_speed;
+    // most, so the walls need not travel far; their speed is capped at the shear's lid speed,
+    // or at that of I = 1e-3 for a faster shear (so that the sample can come to rest).
+    let v_max = strain_rate
+        * (CONSOLIDATION_INERTIAL_NUMBER / spec.inertial_number).min(1.0)
+        * column.height;
     let settle = 50.0 * d_mean / v_max;
     sample.consolidate(spec.confining, d_mean, v_max, settle)?;
     let (prep_time, prep_steps) = (sample.dem.time(), sample.dem.step_count());
@@ -480,7 +484,7 @@ pub fn run_biaxial(spec: &BiaxialSpec, progress: crate::run::Progress) -> Result
     let (mut acc, mut count) = ([0.0; 3], 0usize);
     let mut next_record = spec.record_strain;
     loop {
-        let s = sample.interval(spec.confining, None, lid_speed, 10.0 * v_max)?;
+        let s = sample.interval(spec.confining, None, lid_speed, 10.0 * lid_speed)?;
         for (a, v) in acc.iter_mut().zip(s) {
             *a += v;
         }

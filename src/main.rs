@@ -73,7 +73,7 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
         /// Confining stress σ₃ (Pa), e.g. the mean stress in the column, ρ φ g H/2.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         confining: f64,
         /// Grains in the sample (about half as wide as high).
         #[arg(long, default_value_t = 1000)]
@@ -565,19 +565,7 @@ fn biaxial(
     let total = (strain / spec.record_strain) as u64;
     let r = with_progress(total, "points", |p| run_biaxial_to(&spec, out, p))
         .with_context(|| format!("biaxial test of {} stopped", path.display()))?;
-    println!(
-        "done: critical-state φ = {:.2}° (sin φ = {:.4} ± {:.4}), peak φ = {:.2}° at ε₁ = {:.3}, \
-         packing {:.3} → {:.3}, ε̇ = {:.3} 1/s, {} steps",
-        r.critical_phi_deg,
-        r.critical_sin_phi,
-        r.critical_sin_phi_sd,
-        r.peak_phi_deg,
-        r.peak_strain,
-        r.initial_packing_fraction,
-        r.critical_packing_fraction,
-        r.strain_rate,
-        r.steps
-    );
+    println!("done: {}", r.done_line());
     Ok(ExitCode::SUCCESS)
 }
 

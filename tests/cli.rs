@@ -197,3 +197,41 @@ fn bad_input_names_the_field_and_the_reason() {
         &["trt"],
     );
 }
+
+/// `granflow biaxial` refuses a bad test before running it, naming the option and the reason,
+/// and leaves no output folder behind.
+#[test]
+fn biaxial_refuses_bad_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/column_collapse/dem_a2.toml");
+    for (args, expect) in [
+        (
+            ["--confining", "1000", "--grains", "50"],
+            ["biaxial.grains", "at least 100"],
+        ),
+        (
+            ["--confining", "-5", "--grains", "300"],
+            ["biaxial.confining", "must be > 0"],
+        ),
+        (
+            ["--confining", "1000", "--strain", "0.7"],
+            ["biaxial.final_strain", "below 0.5"],
+        ),
+    ] {
+        let out_dir = dir.path().join("bx");
+        let out = granflow()
+            .arg("biaxial")
+            .arg(&model)
+            .args(args)
+            .arg("--out")
+            .arg(&out_dir)
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        for e in expect {
+            assert!(err.contains(e), "expected `{e}` in: {err}");
+        }
+        assert!(!out_dir.exists());
+    }
+}

@@ -138,6 +138,30 @@ pub struct BiaxialResult {
     pub points: Vec<BiaxialPoint>,
 }
 
+impl BiaxialResult {
+    /// One line with the friction angles, the densities, σ₃ held and the quasi-static check.
+    pub fn done_line(&self) -> String {
+        let end = self.points.last().map_or(f64::NAN, |p| p.volumetric_strain);
+        format!(
+            "critical-state φ = {:.2}° (sin φ = {:.4} ± {:.4}), peak φ = {:.2}° at ε₁ = {:.3}, \
+             packing {:.4} → {:.4}, ε_v(end) = {:.4}, σ₃ held at {:.1} Pa, lid − floor σ₁ \
+             {:.1e}, ε̇ = {:.3} 1/s, {} steps",
+            self.critical_phi_deg,
+            self.critical_sin_phi,
+            self.critical_sin_phi_sd,
+            self.peak_phi_deg,
+            self.peak_strain,
+            self.initial_packing_fraction,
+            self.critical_packing_fraction,
+            end,
+            self.critical_sigma_3,
+            self.lid_floor_difference,
+            self.strain_rate,
+            self.steps
+        )
+    }
+}
+
 /// Normal force on each wall (N) from the last force evaluation.
 fn wall_forces(dem: &Dem) -> [f64; 4] {
     let mut f = [0.0; 4];
@@ -186,7 +210,7 @@ struct Sample {
     dem: Dem,
     thickness: f64,
     solid_area: f64,
-    /// Mass of each piston (kg): the sample's.
+    /// Mass of each piston (kg): a tenth of the sample's, or what stability needs.
     mass: f64,
     /// Pistons of the right wall and the lid.
     piston: [Piston; 2],

@@ -409,7 +409,6 @@ fn moving_floor_lifts_a_disk_with_a_still_dashpot() {
         DemParams::new(law, law, [0.0, -g]),
     )
     .unwrap();
-    dem.grains.vy[0] = 0.0;
     dem.set_wall_velocity(0, [0.0, u]).unwrap();
     dem.advance_with(0.5, None).unwrap();
     let Wall::Plane { point, .. } = dem.walls[0] else {

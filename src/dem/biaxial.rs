@@ -434,7 +434,7 @@ pub fn run_biaxial(spec: &BiaxialSpec, progress: crate::run::Progress) -> Result
     })?;
     let mut g = column.grains;
     let n = g.len();
-    let solid_area: f64 = g.radius.iter().map(|r| std::f64::consts::PI * r * r).sum();
+    let solid_area = g.area();
     let d_mean = 2.0 * g.radius.iter().sum::<f64>() / n as f64;
     let sample_mass: f64 = g.mass.iter().sum();
     let rho_s = spec.column.density / spec.thickness;
@@ -489,12 +489,7 @@ pub fn run_biaxial(spec: &BiaxialSpec, progress: crate::run::Progress) -> Result
     let (prep_time, prep_steps) = (sample.dem.time(), sample.dem.step_count());
     let walls = sample.dem.walls.clone();
     let mut grains = sample.dem.grains.clone();
-    grains
-        .vx
-        .iter_mut()
-        .chain(grains.vy.iter_mut())
-        .chain(grains.omega.iter_mut())
-        .for_each(|v| *v = 0.0);
+    grains.stop();
     sample.dem = Dem::new(grains, walls, no_gravity(&spec.material))?;
     sample.piston = [Piston::default(); 2];
     sample.consolidate(spec.confining, d_mean, v_max, settle)?;

@@ -143,6 +143,15 @@ impl Grains {
         self.radius.iter().copied().fold(0.0, f64::max)
     }
 
+    /// Bring every grain to rest: velocities and angular velocities set to 0.
+    pub fn stop(&mut self) {
+        self.vx
+            .iter_mut()
+            .chain(self.vy.iter_mut())
+            .chain(self.omega.iter_mut())
+            .for_each(|v| *v = 0.0);
+    }
+
     /// Total linear momentum Σ m v.
     pub fn momentum(&self) -> [f64; 2] {
         let mut p = [0.0; 2];

@@ -216,10 +216,7 @@ pub fn deposit_column(spec: &ColumnSpec) -> Result<Column> {
         settle_time += dem.time();
     }
     let mut g = dem.grains;
-    g.vx.iter_mut()
-        .chain(g.vy.iter_mut())
-        .chain(g.omega.iter_mut())
-        .for_each(|v| *v = 0.0);
+    g.stop();
     let height = (0..g.len())
         .map(|i| g.y[i] + g.radius[i])
         .fold(0.0, f64::max);

@@ -91,6 +91,37 @@ enum Command {
         #[arg(long)]
         seed: Option<u64>,
     },
+    /// Periodic simple shear (Lees–Edwards) of a DEM collapse scenario's material at a set of
+    /// inertial numbers and a fixed normal stress: its μ(I) and solid fraction φ(I), and the fit
+    /// sin φ(I) = sin φ_s + (sin φ_2 − sin φ_s)/(I_0/I + 1) a plane-strain continuum of the
+    /// material takes. Writes mu_i.csv, shear_<k>.csv, summary.json and mu_i.svg.
+    Shear {
+        /// DEM collapse scenario (TOML): its grains and grain–grain contact laws are used.
+        scenario: PathBuf,
+        /// Output folder (created if needed).
+        #[arg(long)]
+        out: PathBuf,
+        /// Normal stress σ_yy held by the cell's height (Pa).
+        #[arg(long, allow_negative_numbers = true)]
+        pressure: f64,
+        /// Inertial numbers I = γ̇ d̄/√(P/ρ_s), comma-separated (one test each).
+        #[arg(
+            long,
+            value_delimiter = ',',
+            allow_negative_numbers = true,
+            required = true
+        )]
+        inertial_numbers: Vec<f64>,
+        /// Grains in the cell.
+        #[arg(long, default_value_t = 500)]
+        grains: usize,
+        /// Shear strain γ of each test (the steady state is its second half).
+        #[arg(long, default_value_t = 5.0)]
+        strain: f64,
+        /// Seed of the sizes (default: the scenario's).
+        #[arg(long)]
+        seed: Option<u64>,
+    },
     /// Throughput benchmarks.
     Bench {
         #[command(subcommand)]
@@ -240,6 +271,23 @@ fn real_main() -> Result<ExitCode> {
             [confining, inertial_number, strain],
             grains,
             prep_friction,
+            seed,
+        ),
+        Command::Shear {
+            scenario,
+            out,
+            pressure,
+            inertial_numbers,
+            grains,
+            strain,
+            seed,
+        } => shear(
+            &scenario,
+            &out,
+            pressure,
+            &inertial_numbers,
+            grains,
+            strain,
             seed,
         ),
         Command::Bench { which } => bench(which),
@@ -566,6 +614,54 @@ fn biaxial(
     let r = with_progress(total, "points", |p| run_biaxial_to(&spec, out, p))
         .with_context(|| format!("biaxial test of {} stopped", path.display()))?;
     println!("done: {}", r.done_line());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `granflow shear`.
+fn shear(
+    path: &Path,
+    out: &Path,
+    pressure: f64,
+    inertial_numbers: &[f64],
+    grains: usize,
+    strain: f64,
+    seed: Option<u64>,
+) -> Result<ExitCode> {
+    use granflow::dem::mu_i::{run_mu_i_to, ShearSpec};
+    let s = DemScenario::from_file(path)?;
+    let specs = inertial_numbers
+        .iter()
+        .map(|&i| ShearSpec::from_scenario(&s, grains, pressure, i, strain, seed))
+        .collect::<granflow::Result<Vec<_>>>()?;
+    eprintln!(
+        "{}: periodic simple shear, {grains} grains, P = {pressure} Pa, I = {inertial_numbers:?}, \
+         to γ = {strain} -> {}",
+        s.name,
+        out.display()
+    );
+    let r = run_mu_i_to(&specs, out)
+        .with_context(|| format!("shear test of {} stopped", path.display()))?;
+    for t in &r.tests {
+        println!("{}", t.done_line());
+    }
+    if let Some(f) = &r.fit {
+        println!(
+            "fit: sin φ(I) = {:.4} + ({:.4} − {:.4})/(I_0/I + 1), I_0 = {:.4} (φ_s = {:.2}°, \
+             φ_2 = {:.2}°, rms {:.1e}{})",
+            f.sin_phi_s,
+            f.sin_phi_2,
+            f.sin_phi_s,
+            f.i_0,
+            f.phi_s_deg,
+            f.phi_2_deg,
+            f.rms,
+            if f.i_0_at_grid_end {
+                "; I_0 at the end of its grid: not bounded by these points"
+            } else {
+                ""
+            }
+        );
+    }
     Ok(ExitCode::SUCCESS)
 }
 

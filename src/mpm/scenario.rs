@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use super::boundary::{Side, Wall, WallKind};
 use super::grid::Grid;
-use super::material::{LinearElastic, MaterialModel, MohrCoulomb};
+use super::material::{LinearElastic, MaterialModel, MohrCoulomb, MuIMohrCoulomb};
 use super::points::Points;
 use super::shape::ShapeKind;
 use super::solver::{cfl_step, Mpm, MpmParams, Scheme, Transfer};
@@ -71,6 +71,33 @@ pub enum MaterialSpec {
         poisson_ratio: f64,
         /// Friction angle φ (degrees).
         friction_angle_deg: f64,
+        /// Dilatancy angle ψ (degrees).
+        dilatancy_angle_deg: f64,
+        /// Cohesion c (Pa).
+        cohesion: f64,
+        /// Tension cut-off σ_t (Pa).
+        tension_cutoff: f64,
+    },
+    /// Mohr–Coulomb with the μ(I) friction of dense granular flow
+    /// ([`crate::mpm::material::mu_i`]): sin φ(I) = sin φ_s + (sin φ_2 − sin φ_s)/(I_0/I + 1),
+    /// I = γ̇ d/√(p/ρ_s); `granflow shear` measures the three for a DEM material.
+    MohrCoulombMuI {
+        /// Density ρ (kg/m³).
+        density: f64,
+        /// Young's modulus E (Pa).
+        youngs_modulus: f64,
+        /// Poisson's ratio ν.
+        poisson_ratio: f64,
+        /// Quasi-static friction angle φ_s (degrees).
+        friction_angle_deg: f64,
+        /// Friction angle φ_2 at large I (degrees, ≥ φ_s).
+        friction_angle_2_deg: f64,
+        /// I_0: the inertial number at which sin φ is halfway from φ_s to φ_2.
+        inertial_number_0: f64,
+        /// Grain diameter d (m) and grain density ρ_s (kg/m³) of the inertial number.
+        grain_diameter: f64,
+        /// See `grain_diameter`.
+        grain_density: f64,
         /// Dilatancy angle ψ (degrees).
         dilatancy_angle_deg: f64,
         /// Cohesion c (Pa).
@@ -209,34 +236,91 @@ impl MaterialSpec {
                 dilatancy_angle_deg,
                 cohesion,
                 tension_cutoff,
+            } => MaterialModel::MohrCoulomb(mohr_coulomb(
+                elastic("material", density, youngs_modulus, poisson_ratio)?,
+                friction_angle_deg,
+                dilatancy_angle_deg,
+                cohesion,
+                tension_cutoff,
+            )?),
+            MaterialSpec::MohrCoulombMuI {
+                density,
+                youngs_modulus,
+                poisson_ratio,
+                friction_angle_deg,
+                friction_angle_2_deg,
+                inertial_number_0,
+                grain_diameter,
+                grain_density,
+                dilatancy_angle_deg,
+                cohesion,
+                tension_cutoff,
             } => {
-                let el = elastic("material", density, youngs_modulus, poisson_ratio)?;
-                if !(friction_angle_deg > 0.0 && friction_angle_deg < 90.0) {
+                let base = mohr_coulomb(
+                    elastic("material", density, youngs_modulus, poisson_ratio)?,
+                    friction_angle_deg,
+                    dilatancy_angle_deg,
+                    cohesion,
+                    tension_cutoff,
+                )?;
+                if !(friction_angle_2_deg >= friction_angle_deg && friction_angle_2_deg < 90.0) {
                     return Err(Error::config(
-                        "material.friction_angle_deg",
-                        format!("must be in (0, 90), got {friction_angle_deg}"),
-                    ));
-                }
-                if !(dilatancy_angle_deg >= 0.0 && dilatancy_angle_deg <= friction_angle_deg) {
-                    return Err(Error::config(
-                        "material.dilatancy_angle_deg",
+                        "material.friction_angle_2_deg",
                         format!(
-                            "must be in [0, φ = {friction_angle_deg}], got {dilatancy_angle_deg}"
+                            "must be in [φ_s = {friction_angle_deg}, 90), got {friction_angle_2_deg}"
                         ),
                     ));
                 }
-                non_negative("material.cohesion", cohesion)?;
-                non_negative("material.tension_cutoff", tension_cutoff)?;
-                MaterialModel::MohrCoulomb(MohrCoulomb::new(
-                    el,
-                    friction_angle_deg.to_radians(),
-                    dilatancy_angle_deg.to_radians(),
-                    cohesion,
-                    tension_cutoff,
+                for (field, v) in [
+                    ("material.inertial_number_0", inertial_number_0),
+                    ("material.grain_diameter", grain_diameter),
+                    ("material.grain_density", grain_density),
+                ] {
+                    if !(v > 0.0 && v.is_finite()) {
+                        return Err(Error::config(field, format!("must be > 0, got {v}")));
+                    }
+                }
+                MaterialModel::MuI(MuIMohrCoulomb::new(
+                    base,
+                    friction_angle_2_deg.to_radians(),
+                    inertial_number_0,
+                    grain_diameter,
+                    grain_density,
                 ))
             }
         })
     }
+}
+
+/// The Mohr–Coulomb material, its angles (degrees) and strengths checked.
+fn mohr_coulomb(
+    el: LinearElastic,
+    friction_angle_deg: f64,
+    dilatancy_angle_deg: f64,
+    cohesion: f64,
+    tension_cutoff: f64,
+) -> Result<MohrCoulomb> {
+    if !(friction_angle_deg > 0.0 && friction_angle_deg < 90.0) {
+        return Err(Error::config(
+            "material.friction_angle_deg",
+            format!("must be in (0, 90), got {friction_angle_deg}"),
+        ));
+    }
+    if !(dilatancy_angle_deg >= 0.0 && dilatancy_angle_deg <= friction_angle_deg) {
+        return Err(Error::config(
+            "material.dilatancy_angle_deg",
+            format!("must be in [0, φ = {friction_angle_deg}], got {dilatancy_angle_deg}"),
+        ));
+    }
+    non_negative("material.cohesion", cohesion)?;
+    non_negative("material.tension_cutoff", tension_cutoff)?;
+    Ok(MohrCoulomb::new(
+        el,
+        friction_angle_deg.to_radians(),
+        dilatancy_angle_deg.to_radians(),
+        cohesion,
+        tension_cutoff,
+    ))
 }
 
 /// n if `v` is within 1e-6 of the integer n ≥ 1.

@@ -937,7 +937,7 @@ impl Mpm {
                             let de = [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])];
                             let spin = 0.5 * dt * (l[1] - l[2]);
                             let s0 = sig[q];
-                            let s1 = mat.update_stress(&s0, &de, spin, &mut state[q]);
+                            let s1 = mat.update_stress(&s0, &de, spin, dt, &mut state[q]);
                             let smid = [
                                 0.5 * (s0[0] + s1[0]),
                                 0.5 * (s0[1] + s1[1]),

@@ -61,6 +61,7 @@ impl Material for LinearElastic {
         stress: &Stress,
         de: &Strain,
         spin: f64,
+        _dt: f64,
         _: &mut MaterialState,
     ) -> Stress {
         self.trial(stress, de, spin)

@@ -1,6 +1,7 @@
 //! Constitutive laws behind one interface, [`Material::update_stress`]: given the Cauchy
-//! stress at the start of a step, the strain increment Δε = Δt·sym(∇v) and the spin increment
-//! Δω = Δt·½(∂v_x/∂y − ∂v_y/∂x), return the stress at the end of the step.
+//! stress at the start of a step, the strain increment Δε = Δt·sym(∇v), the spin increment
+//! Δω = Δt·½(∂v_x/∂y − ∂v_y/∂x) and the step Δt (for rate-dependent laws), return the stress
+//! at the end of the step.
 //!
 //! Objectivity (Jaumann rate): the law sees the stress rotated with the material,
 //! σ* = σ + Δt(W σ − σ W) with W = [[0, Δω], [−Δω, 0]]/Δt, i.e.
@@ -12,9 +13,11 @@
 
 pub mod elastic;
 pub mod mohr_coulomb;
+pub mod mu_i;
 
 pub use elastic::LinearElastic;
 pub use mohr_coulomb::MohrCoulomb;
+pub use mu_i::MuIMohrCoulomb;
 
 /// Plane-strain Cauchy stress (Pa): xx, yy, xy, zz.
 pub type Stress = [f64; 4];
@@ -37,12 +40,13 @@ pub struct MaterialState {
 /// The material contract (cb-geo's `compute_stress`, with the spin passed for objectivity),
 /// so a DEM representative volume can later stand behind the same interface.
 pub trait Material: Sync + Send {
-    /// Stress after a step with strain increment `dstrain` and spin increment `spin`.
+    /// Stress after a step of `dt` with strain increment `dstrain` and spin increment `spin`.
     fn update_stress(
         &self,
         stress: &Stress,
         dstrain: &Strain,
         spin: f64,
+        dt: f64,
         state: &mut MaterialState,
     ) -> Stress;
     /// Mass density ρ (kg/m³).
@@ -72,6 +76,8 @@ pub enum MaterialModel {
     Elastic(LinearElastic),
     /// Mohr–Coulomb elastic–perfectly plastic.
     MohrCoulomb(MohrCoulomb),
+    /// Mohr–Coulomb with the friction angle of the μ(I) rheology.
+    MuI(MuIMohrCoulomb),
 }
 
 impl Material for MaterialModel {
@@ -81,29 +87,34 @@ impl Material for MaterialModel {
         stress: &Stress,
         dstrain: &Strain,
         spin: f64,
+        dt: f64,
         state: &mut MaterialState,
     ) -> Stress {
         match self {
-            MaterialModel::Elastic(m) => m.update_stress(stress, dstrain, spin, state),
-            MaterialModel::MohrCoulomb(m) => m.update_stress(stress, dstrain, spin, state),
+            MaterialModel::Elastic(m) => m.update_stress(stress, dstrain, spin, dt, state),
+            MaterialModel::MohrCoulomb(m) => m.update_stress(stress, dstrain, spin, dt, state),
+            MaterialModel::MuI(m) => m.update_stress(stress, dstrain, spin, dt, state),
         }
     }
     fn density(&self) -> f64 {
         match self {
             MaterialModel::Elastic(m) => m.density(),
             MaterialModel::MohrCoulomb(m) => m.density(),
+            MaterialModel::MuI(m) => m.density(),
         }
     }
     fn p_wave_modulus(&self) -> f64 {
         match self {
             MaterialModel::Elastic(m) => m.p_wave_modulus(),
             MaterialModel::MohrCoulomb(m) => m.p_wave_modulus(),
+            MaterialModel::MuI(m) => m.p_wave_modulus(),
         }
     }
     fn elastic_energy_density(&self, stress: &Stress) -> f64 {
         match self {
             MaterialModel::Elastic(m) => m.elastic_energy_density(stress),
             MaterialModel::MohrCoulomb(m) => m.elastic_energy_density(stress),
+            MaterialModel::MuI(m) => m.elastic_energy_density(stress),
         }
     }
 }

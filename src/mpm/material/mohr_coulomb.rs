@@ -328,6 +328,7 @@ impl Material for MohrCoulomb {
         stress: &Stress,
         de: &Strain,
         spin: f64,
+        _dt: f64,
         state: &mut MaterialState,
     ) -> Stress {
         self.update(stress, de, spin, state).0

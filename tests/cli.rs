@@ -198,6 +198,52 @@ fn bad_input_names_the_field_and_the_reason() {
     );
 }
 
+/// `granflow shear` refuses a bad test before running any, naming the option and the reason,
+/// and leaves no output folder behind.
+#[test]
+fn shear_refuses_bad_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/column_collapse/dem_a2.toml");
+    for (args, expect) in [
+        (
+            ["--pressure", "1000", "--grains", "50"],
+            ["shear.grains", "at least 100"],
+        ),
+        (
+            ["--pressure", "-5", "--grains", "300"],
+            ["shear.pressure", "must be > 0"],
+        ),
+        (
+            ["--pressure", "1000", "--strain", "0.5"],
+            ["shear.strain", "≥ 1"],
+        ),
+        (
+            ["--pressure", "1000", "--inertial-numbers", "0.1,2"],
+            ["shear.inertial_number", "≤ 1"],
+        ),
+    ] {
+        let out_dir = dir.path().join("sh");
+        let mut args = args.to_vec();
+        if !args.contains(&"--inertial-numbers") {
+            args.extend(["--inertial-numbers", "0.1,0.2"]);
+        }
+        let out = granflow()
+            .arg("shear")
+            .arg(&model)
+            .args(args)
+            .arg("--out")
+            .arg(&out_dir)
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        for e in expect {
+            assert!(err.contains(e), "expected `{e}` in: {err}");
+        }
+        assert!(!out_dir.exists());
+    }
+}
+
 /// `granflow biaxial` refuses a bad test before running it, naming the option and the reason,
 /// and leaves no output folder behind.
 #[test]

@@ -64,6 +64,36 @@ fn collapse_models_parse_and_match_the_dem_geometry() {
     }
 }
 
+/// The μ(I) model: the measured law parses and builds; φ_2 below φ_s, a missing grain size
+/// and a non-positive I_0 are refused naming the field.
+#[test]
+fn mu_i_material_is_checked() {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("models/column_collapse/mpm_a2_mu_i.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    MpmScenario::from_toml(&text).unwrap().build().unwrap();
+    for (from, to, field) in [
+        (
+            "friction_angle_2_deg = 38.75",
+            "friction_angle_2_deg = 10.0",
+            "material.friction_angle_2_deg",
+        ),
+        (
+            "inertial_number_0 = 0.1413",
+            "inertial_number_0 = 0.0",
+            "material.inertial_number_0",
+        ),
+    ] {
+        let s = MpmScenario::from_toml(&text.replace(from, to)).unwrap();
+        let e = s.derive().unwrap_err().to_string();
+        assert!(e.contains(field), "{e}");
+    }
+    let e = MpmScenario::from_toml(&text.replace("grain_diameter = 1.116e-3\n", ""))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("grain_diameter"), "{e}");
+}
+
 /// Misspelt keys and bad values are refused with the field named; a Δt above C h/c is refused
 /// with the limit in the message.
 #[test]

@@ -377,7 +377,8 @@ pub fn run_shear(spec: &ShearSpec, progress: crate::run::Progress) -> Result<She
         profile_slope,
         profile_deviation,
         width: cell.lx,
-        height: mean_height(&cell, mean.packing_fraction),
+        // The height that holds the grains at the mean solid fraction.
+        height: cell.ly * cell.packing_fraction() / mean.packing_fraction,
         dt,
         steps: cell.steps,
         preparation_time,
@@ -388,11 +389,6 @@ pub fn run_shear(spec: &ShearSpec, progress: crate::run::Progress) -> Result<She
 
 /// Bins of the velocity profile.
 const PROFILE_BINS: usize = 10;
-
-/// The cell height that gives packing fraction `phi` (the mean height when `phi` is the mean).
-fn mean_height(cell: &Cell, phi: f64) -> f64 {
-    cell.ly * cell.packing_fraction() / phi
-}
 
 /// Least-squares slope of the binned profile (Σ u_x and count per bin of y/L_y) over the
 /// mean one, and the largest deviation of a bin mean from the line; both in units of

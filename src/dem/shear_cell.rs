@@ -394,16 +394,6 @@ impl Cell {
         a / (self.lx * self.ly)
     }
 
-    /// Total momentum of the fluctuations about the mean flow, Σ m v′.
-    pub fn fluctuation_momentum(&self) -> [f64; 2] {
-        let mut p = [0.0; 2];
-        for i in 0..self.len() {
-            p[0] += self.m[i] * (self.vx[i] - self.gdot * (self.y[i] - 0.5 * self.ly));
-            p[1] += self.m[i] * self.vy[i];
-        }
-        p
-    }
-
     /// Positions and velocities (for the tests).
     pub fn grain(&self, i: usize) -> [f64; 4] {
         [self.x[i], self.y[i], self.vx[i], self.vy[i]]

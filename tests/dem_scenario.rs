@@ -124,6 +124,11 @@ fn bad_values_are_refused_with_the_field_named() {
             "rolling_friction = -0.1\nrest_fraction",
             "deposition.rolling_friction",
         ),
+        (
+            "[deposition]\n",
+            "[deposition]\nsettling_velocity = 0.0\n",
+            "deposition.settling_velocity",
+        ),
     ] {
         assert!(base.contains(from), "{from}");
         let s = DemScenario::from_toml(&base.replacen(from, to, 1)).unwrap();
@@ -133,6 +138,29 @@ fn bad_values_are_refused_with_the_field_named() {
     // Misspelt or missing keys are refused by the parser (no silent defaults).
     assert!(DemScenario::from_toml(&base.replace("thickness", "thicknes")).is_err());
     assert!(DemScenario::from_toml(&base.replace("gravity = 9.81\n", "")).is_err());
+}
+
+/// `deposition.settling_velocity` v_s deposits against the drag α = g/v_s and then relaxes under
+/// the undamped grain laws; without it, free fall and (same laws) no relaxation.
+#[test]
+fn settling_velocity_sets_the_deposition_drag_and_the_relaxation() {
+    let base = tiny();
+    let free = DemScenario::from_toml(&base).unwrap().derive().unwrap();
+    assert_eq!(free.column.params.global_damping, 0.0);
+    assert!(free.column.relax.is_none());
+    let text = base.replacen(
+        "[deposition]\n",
+        "[deposition]\nsettling_velocity = 0.02\n",
+        1,
+    );
+    let settled = DemScenario::from_toml(&text).unwrap().derive().unwrap();
+    approx::assert_relative_eq!(settled.column.params.global_damping, 9.81 / 0.02);
+    let relax = settled
+        .column
+        .relax
+        .expect("a relaxation under the grain laws");
+    assert_eq!(relax.global_damping, 0.0);
+    assert_eq!(relax.grain, settled.column.params.grain);
 }
 
 /// A ≈ 60-grain a = 1 collapse comes to rest, runs out beyond L_i, keeps its height below

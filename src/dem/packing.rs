@@ -159,7 +159,8 @@ pub struct Column {
 /// Deposit a column by gravity to rest. Grains start on a square lattice of pitch 1.1 d_max
 /// filling the width, jittered by 0.05 d_max, with the floor at y = 0, and fall under
 /// `spec.params` (gravity included) until the kinetic energy per grain is below
-/// `rest_fraction`·m̄ g d̄; then, if `spec.relax` is given, settle to rest again under it.
+/// `rest_fraction`·m̄ g d̄; then, if `spec.relax` is given, settle to rest again under it (for
+/// at least 20 √(d̄/g) when the deposition was damped).
 pub fn deposit_column(spec: &ColumnSpec) -> Result<Column> {
     let [d_min, d_max] = spec.diameter;
     if !(d_min > 0.0 && d_max >= d_min) {
@@ -208,9 +209,17 @@ pub fn deposit_column(spec: &ColumnSpec) -> Result<Column> {
         let walls = dem.walls.clone();
         dem = Dem::new(dem.grains, walls, material.clone())?;
         dem.refresh_forces();
+        // After a damped deposition (sedimentation) every grain is slow by construction, also
+        // one the drag alone was holding: give such a grain 20 √(d̄/g) to fall before the rest
+        // counts (it falls d̄ in √(2 d̄/g)). Undamped deposits came to rest on their contacts.
+        let min_time = if spec.params.global_damping > 0.0 {
+            20.0 * (mean_d / gmag).sqrt()
+        } else {
+            0.0
+        };
         rest.settle(
             &mut dem,
-            0.0,
+            min_time,
             "relaxation under the material's contact laws",
         )?;
         settle_time += dem.time();

@@ -140,6 +140,13 @@ pub struct DepositionSpec {
     /// When either value differs from `grain_contact`, the deposit then settles again under
     /// the grain laws before the release ([`ColumnSpec::relax`]).
     pub rolling_friction: f64,
+    /// Settling velocity v_s (m/s) of a sedimentation: when given, the grains fall against a
+    /// drag −m (g/v_s) **v** (global damping α = g/v_s, seed eq. 5.57), so none falls faster
+    /// than v_s and each lands gently where its friction holds it, as in a column left to
+    /// settle after fluidisation (Rondon et al. 2011). The deposit then settles again under
+    /// the undamped grain laws. Absent: the grains fall freely (dry pluviation).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settling_velocity: Option<f64>,
     /// Rest: kinetic energy per grain below this fraction of m̄ g d̄.
     pub rest_fraction: f64,
     /// Give up after this simulated time (s).
@@ -246,6 +253,9 @@ impl DemScenario {
         let d = &self.deposition;
         non_negative("deposition.friction", d.friction)?;
         non_negative("deposition.rolling_friction", d.rolling_friction)?;
+        if let Some(v) = d.settling_velocity {
+            positive("deposition.settling_velocity", v)?;
+        }
         positive("deposition.rest_fraction", d.rest_fraction)?;
         positive("deposition.max_time", d.max_time)?;
         let t = &self.time;
@@ -281,7 +291,9 @@ impl DemScenario {
         let mut dep = params.clone();
         dep.grain.friction = d.friction;
         dep.grain.rolling_friction = d.rolling_friction;
-        let relax = (dep.grain != params.grain).then(|| params.clone());
+        dep.global_damping = d.settling_velocity.map_or(0.0, |v| self.gravity / v);
+        let relax =
+            (dep.grain != params.grain || dep.global_damping != 0.0).then(|| params.clone());
         let column = ColumnSpec {
             x0: 0.0,
             width: c.width,

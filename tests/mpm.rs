@@ -65,7 +65,7 @@ fn collapse_models_parse_and_match_the_dem_geometry() {
 }
 
 /// The μ(I) model: the measured law parses and builds; φ_2 below φ_s, a missing grain size
-/// and a non-positive I_0 are refused naming the field.
+/// and a non-positive I_0 or I_max are refused naming the field.
 #[test]
 fn mu_i_material_is_checked() {
     let path =
@@ -82,6 +82,11 @@ fn mu_i_material_is_checked() {
             "inertial_number_0 = 0.1413",
             "inertial_number_0 = 0.0",
             "material.inertial_number_0",
+        ),
+        (
+            "inertial_number_max = 0.5",
+            "inertial_number_max = -1.0",
+            "material.inertial_number_max",
         ),
     ] {
         let s = MpmScenario::from_toml(&text.replace(from, to)).unwrap();

@@ -94,6 +94,8 @@ pub enum MaterialSpec {
         friction_angle_2_deg: f64,
         /// I_0: the inertial number at which sin φ is halfway from φ_s to φ_2.
         inertial_number_0: f64,
+        /// I_max: the end of the measured dense-flow range; I is held at it above.
+        inertial_number_max: f64,
         /// Grain diameter d (m) and grain density ρ_s (kg/m³) of the inertial number.
         grain_diameter: f64,
         /// See `grain_diameter`.
@@ -250,6 +252,7 @@ impl MaterialSpec {
                 friction_angle_deg,
                 friction_angle_2_deg,
                 inertial_number_0,
+                inertial_number_max,
                 grain_diameter,
                 grain_density,
                 dilatancy_angle_deg,
@@ -273,6 +276,7 @@ impl MaterialSpec {
                 }
                 for (field, v) in [
                     ("material.inertial_number_0", inertial_number_0),
+                    ("material.inertial_number_max", inertial_number_max),
                     ("material.grain_diameter", grain_diameter),
                     ("material.grain_density", grain_density),
                 ] {
@@ -283,7 +287,7 @@ impl MaterialSpec {
                 MaterialModel::MuI(MuIMohrCoulomb::new(
                     base,
                     friction_angle_2_deg.to_radians(),
-                    inertial_number_0,
+                    [inertial_number_0, inertial_number_max],
                     grain_diameter,
                     grain_density,
                 ))

@@ -4,11 +4,14 @@
 //!
 //! Each update takes the friction angle of the point's inertial number,
 //!
-//! sin φ(I) = sin φ_s + (sin φ_2 − sin φ_s)/(I_0/I + 1),  I = γ̇ d/√(p/ρ_s),
+//! sin φ(I) = sin φ_s + (sin φ_2 − sin φ_s)/(I_0/I + 1),  I = min(γ̇ d/√(p/ρ_s), I_max),
 //!
 //! with γ̇ = √((Δε_xx − Δε_yy)² + (2Δε_xy)²)/Δt the largest in-plane shear strain rate (γ̇ of a
 //! simple shear), p = −(σ_xx + σ_yy)/2 the in-plane pressure at the start of the step, d the
-//! grain diameter and ρ_s the grain density; a stress-free point (p ≤ 0) takes φ_2. sin φ is
+//! grain diameter and ρ_s the grain density; a stress-free point (p ≤ 0) takes I = I_max.
+//! I_max is the end of the dense-flow range in which the law was measured: beyond I ≈ 0.5 the
+//! DEM's shear cell is a granular gas (normal-stress ratio σ_xx/σ_yy 2–6, coordination < 0.2)
+//! whose friction stops rising, so the fit is not carried past it. sin φ is
 //! the 2-D Mohr–Coulomb friction (σ₁ − σ₃)/(σ₁ + σ₃), the quantity the DEM's periodic shear
 //! cell measures (`granflow shear`, [`crate::dem::mu_i`]), so its fitted law can be used as
 //! it is. At I → 0 this is the rate-independent Mohr–Coulomb of angle φ_s; the dilatancy
@@ -25,20 +28,29 @@ pub struct MuIMohrCoulomb {
     sin_s: f64,
     sin_2: f64,
     i_0: f64,
+    /// I_max: I is held at it above (and for a stress-free point).
+    i_max: f64,
     /// d √ρ_s, so that I = γ̇ d √ρ_s/√p.
     d_sqrt_rho: f64,
 }
 
 impl MuIMohrCoulomb {
     /// From the rate-independent material at φ_s, the angle φ_2 (rad, φ_s ≤ φ_2 < π/2), I_0
-    /// (> 0), the grain diameter d (m) and grain density ρ_s (kg/m³); the scenario checks the
-    /// ranges.
-    pub fn new(base: MohrCoulomb, phi_2: f64, i_0: f64, diameter: f64, grain_density: f64) -> Self {
+    /// and I_max (> 0), the grain diameter d (m) and grain density ρ_s (kg/m³); the scenario
+    /// checks the ranges.
+    pub fn new(
+        base: MohrCoulomb,
+        phi_2: f64,
+        [i_0, i_max]: [f64; 2],
+        diameter: f64,
+        grain_density: f64,
+    ) -> Self {
         MuIMohrCoulomb {
             sin_s: base.friction_angle().sin(),
             sin_2: phi_2.sin(),
             base,
             i_0,
+            i_max,
             d_sqrt_rho: diameter * grain_density.sqrt(),
         }
     }
@@ -60,14 +72,11 @@ impl MuIMohrCoulomb {
         }
     }
 
-    /// sin φ(I) (module doc); sin φ_2 for I = ∞.
+    /// sin φ(I) (module doc), I held at I_max above it (also I = ∞).
     #[inline]
     pub fn sin_phi(&self, i: f64) -> f64 {
-        if i.is_finite() {
-            self.sin_s + (self.sin_2 - self.sin_s) * i / (i + self.i_0)
-        } else {
-            self.sin_2
-        }
+        let i = i.min(self.i_max);
+        self.sin_s + (self.sin_2 - self.sin_s) * i / (i + self.i_0)
     }
 }
 
@@ -119,7 +128,7 @@ mod tests {
             poisson_ratio: 0.3,
         };
         let base = MohrCoulomb::new(el, 20f64.to_radians(), 0.0, 0.0, 0.0);
-        MuIMohrCoulomb::new(base, 30f64.to_radians(), 0.3, 1e-3, 2500.0)
+        MuIMohrCoulomb::new(base, 30f64.to_radians(), [0.3, 3.0], 1e-3, 2500.0)
     }
 
     /// Steady simple shear at a prescribed rate: the stress ratio settles on the yield surface
@@ -155,15 +164,19 @@ mod tests {
         }
     }
 
-    /// The law's limits: sin φ_s at I = 0, sin φ_2 at I = ∞ and for a stress-free point,
-    /// halfway at I = I_0.
+    /// The law's limits: sin φ_s at I = 0, halfway to sin φ_2 at I = I_0, and above I_max = 10 I_0
+    /// (and for a stress-free point) held at its value there, (10 sin φ_2 + sin φ_s)/11.
     #[test]
     fn limits_of_the_law() {
         let m = material();
         let (s, s2) = (20f64.to_radians().sin(), 30f64.to_radians().sin());
+        let top = (10.0 * s2 + s) / 11.0;
         assert!((m.sin_phi(0.0) - s).abs() < 1e-15);
-        assert!((m.sin_phi(f64::INFINITY) - s2).abs() < 1e-15);
         assert!((m.sin_phi(0.3) - 0.5 * (s + s2)).abs() < 1e-15);
+        for i in [3.0, 30.0, f64::INFINITY] {
+            assert!((m.sin_phi(i) - top).abs() < 1e-15, "I = {i}");
+        }
+        assert!(m.sin_phi(2.9) < top);
         let free = m.inertial_number(&[0.0; 4], &[0.0, 0.0, 1e-6], 1e-5);
         assert!(free.is_infinite());
     }

@@ -184,6 +184,18 @@ fn unit_column() -> (DemParams, ColumnSpec) {
     (material, spec)
 }
 
+/// Each grain's displacement over 2 time units (≈ 4.5 √(d/g)) of `g` run on under `material`
+/// between the column's walls, from a cleared contact history (as at a release).
+fn run_on_displacements(g: &Grains, material: &DemParams, width: f64) -> Vec<f64> {
+    let walls = vec![Wall::floor(0.0), Wall::left(0.0), Wall::right(width)];
+    let mut dem = Dem::new(g.clone(), walls, material.clone()).unwrap();
+    dem.refresh_forces();
+    dem.steps((2.0 / dem.dt()) as u64);
+    (0..g.len())
+        .map(|i| (dem.grains.x[i] - g.x[i]).hypot(dem.grains.y[i] - g.y[i]))
+        .collect()
+}
+
 /// A rolling-friction cap above the material's during deposition holds the fall in looser
 /// arches (the loose submerged columns, docs/submerged.md: φ 0.795 → 0.773 at 311 grains), and
 /// the relaxation under the material's own laws hands over a column those laws hold: run on
@@ -211,15 +223,9 @@ fn rolling_resistance_in_deposition_loosens_and_relaxation_holds() {
         loose.packing_fraction,
         plain.packing_fraction
     );
-    // Largest and mean displacement over 2 s (≈ 4.5 √(d/g)) run on under the material's laws.
+    // Largest and mean displacement run on under the material's laws.
     let run_on = |g: &Grains| {
-        let walls = vec![Wall::floor(0.0), Wall::left(0.0), Wall::right(spec.width)];
-        let mut dem = Dem::new(g.clone(), walls, material.clone()).unwrap();
-        dem.refresh_forces();
-        dem.steps((2.0 / dem.dt()) as u64);
-        let d: Vec<f64> = (0..g.len())
-            .map(|i| (dem.grains.x[i] - g.x[i]).hypot(dem.grains.y[i] - g.y[i]))
-            .collect();
+        let d = run_on_displacements(g, &material, spec.width);
         (
             d.iter().cloned().fold(0.0, f64::max),
             d.iter().sum::<f64>() / d.len() as f64,
@@ -276,23 +282,14 @@ fn sedimentation_deposits_a_looser_column_that_holds_without_the_drag() {
         settled.packing_fraction,
         free.packing_fraction
     );
-    // Displacements over 2 s (≈ 4.5 √(d/g)) run on under the grain laws without the drag,
-    // from the contact history cleared (as at a release).
-    let run_on = |g: &Grains| -> Vec<f64> {
-        let walls = vec![Wall::floor(0.0), Wall::left(0.0), Wall::right(spec.width)];
-        let mut dem = Dem::new(g.clone(), walls, material.clone()).unwrap();
-        dem.refresh_forces();
-        dem.steps((2.0 / dem.dt()) as u64);
-        (0..g.len())
-            .map(|i| (dem.grains.x[i] - g.x[i]).hypot(dem.grains.y[i] - g.y[i]))
-            .collect()
-    };
-    let stats = |d: &[f64]| {
+    // Mean displacement and grains beyond 0.1 d_min run on under the grain laws, no drag.
+    let run_on = |g: &Grains| {
+        let d = run_on_displacements(g, &material, spec.width);
         let far = d.iter().filter(|&&x| x > 0.1 * 0.8).count();
         (d.iter().sum::<f64>() / d.len() as f64, far)
     };
-    let (mean, far) = stats(&run_on(&settled.grains));
-    let (mean_free, far_free) = stats(&run_on(&free.grains));
+    let (mean, far) = run_on(&settled.grains);
+    let (mean_free, far_free) = run_on(&free.grains);
     println!(
         "run on without the drag: mean displacement {mean:.5}, {far} grains beyond 0.1 d_min \
          (free-fall deposit: {mean_free:.5}, {far_free})"

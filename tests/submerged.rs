@@ -359,15 +359,16 @@ fn ladd_method_runs() {
 /// critical state) builds a positive excess pore pressure at its base while it collapses, a
 /// dense one (φ ≈ 0.83) a negative one. `models/submerged/{loose,dense}_a0.8_viscous.toml` as
 /// they are (300 grains), run to 5 τ_c (the loose columns reach half their run-out at
-/// 6.4–7.0 τ_c, the dense at 10–16 τ_c), both at once; the mean of `pore_pressure_base` over
+/// 5.5–7.5 τ_c, one seed 12.3, the dense at 10–16 τ_c), both at once; the mean of `pore_pressure_base` over
 /// (0, 5 τ_c], over the buoyant weight (ρ_s − ρ_f) φ g H_i.
 ///
 /// Seeds 2011–2015 (docs/submerged.md, "Sedimented loose columns"): loose +0.040, +0.107,
 /// +0.034, −0.037, +0.009 over this window (the negative one is the densest deposit, φ 0.774);
 /// dense −0.085 to −0.105 over (0, t_½], seed 2011 −0.083 over this window. Seed 2011 of each
-/// file runs here: the bounds leave it half its value, since the thread count reorders sums
-/// and a chaotic collapse amplifies that (two binaries that deposit the same φ gave +0.041 and
-/// +0.047 over (0, t_½]).
+/// file runs here (two threads here and one in the table give the same value to 4 digits);
+/// the bounds leave it half its value, since the collapse is chaotic and amplifies any change
+/// of code or deposit (two binaries that deposit the same φ gave +0.041 and +0.047 over
+/// (0, t_½]).
 #[test]
 fn viscous_loose_column_has_positive_and_dense_negative_base_pore_pressure() {
     let run = |file: &str| -> f64 {

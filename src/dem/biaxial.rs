@@ -458,9 +458,13 @@ pub fn run_biaxial(spec: &BiaxialSpec, progress: crate::run::Progress) -> Result
         rolling_friction: 0.0,
         ..*p
     };
+    // Consolidation and shear run without gravity and without a sedimentation's drag (a
+    // deposition device, `deposition.settling_velocity`: it would hold the pistons' approach
+    // back so that the sample never counts as at rest).
     let no_gravity = |p: &DemParams| {
         let mut q = p.clone();
         q.gravity = [0.0; 2];
+        q.global_damping = 0.0;
         q.wall = frictionless(&spec.material.wall);
         q
     };

@@ -261,8 +261,8 @@ fn rolling_resistance_in_deposition_loosens_and_relaxation_holds() {
 #[test]
 fn sedimentation_deposits_a_looser_column_that_holds_without_the_drag() {
     let (material, spec) = unit_column();
-    // v_s = 0.16 √(g d̄).
     let free = deposit_column(&spec).unwrap();
+    // v_s = 0.16 √(g d̄), g = 10, d̄ ≈ 1.
     let v_s = 0.16 * 10f64.sqrt();
     let mut drag = material.clone();
     drag.global_damping = 10.0 / v_s;

@@ -200,8 +200,8 @@ impl DemScenario {
     /// Check every value and derive the solver set-up. Refuses, naming the field: non-positive
     /// sizes, densities, stiffnesses or intervals; d_max < d_min; a column narrower than
     /// 4 d_max; a box not longer than the column; φ_est outside (0.5, 0.91); λ outside (0, 1];
-    /// deposition friction or rolling friction < 0; a settling velocity ≤ 0; and (through [`crate::dem::Dem::new`]
-    /// later) a step above λ Δt_cr.
+    /// deposition friction or rolling friction < 0; a settling velocity ≤ 0; and (through
+    /// [`crate::dem::Dem::new`] later) a step above λ Δt_cr.
     pub fn derive(&self) -> Result<DerivedDem> {
         positive("gravity", self.gravity)?;
         let g = &self.grains;

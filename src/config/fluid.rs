@@ -121,6 +121,47 @@ pub struct MrtSpec {
     pub s_q: f64,
 }
 
+impl MrtSpec {
+    /// The MRT rates a scenario asks for: `spec` if given, else [`MrtRates::standard`] for τ;
+    /// `None` for BGK. Rates given with BGK, or outside (0, 2), are refused naming
+    /// `<table>.mrt.<rate>`.
+    pub fn resolve(
+        spec: Option<MrtSpec>,
+        collision: CollisionKind,
+        tau: f64,
+        table: &str,
+    ) -> Result<Option<MrtRates>> {
+        let rates = match (collision, spec) {
+            (CollisionKind::Bgk, Some(_)) => {
+                return Err(Error::config(
+                    format!("{table}.mrt"),
+                    format!("MRT rates given but {table}.collision = \"bgk\""),
+                ))
+            }
+            (CollisionKind::Bgk, None) => return Ok(None),
+            (CollisionKind::Mrt, Some(m)) => MrtRates {
+                s_e: m.s_e,
+                s_eps: m.s_eps,
+                s_q: m.s_q,
+            },
+            (CollisionKind::Mrt, None) => MrtRates::standard(tau),
+        };
+        for (name, v) in [
+            ("s_e", rates.s_e),
+            ("s_eps", rates.s_eps),
+            ("s_q", rates.s_q),
+        ] {
+            if !(v > 0.0 && v < 2.0) {
+                return Err(Error::config(
+                    format!("{table}.mrt.{name}"),
+                    format!("relaxation rate {v} must lie in (0, 2)"),
+                ));
+            }
+        }
+        Ok(Some(rates))
+    }
+}
+
 /// Edge conditions.
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -406,40 +447,7 @@ impl Scenario {
                 ));
             }
         }
-        let mrt = match self.lbm.collision {
-            CollisionKind::Bgk => {
-                if self.lbm.mrt.is_some() {
-                    return Err(Error::config(
-                        "lbm.mrt",
-                        "MRT rates given but lbm.collision = \"bgk\"",
-                    ));
-                }
-                None
-            }
-            CollisionKind::Mrt => {
-                let r = match self.lbm.mrt {
-                    Some(m) => MrtRates {
-                        s_e: m.s_e,
-                        s_eps: m.s_eps,
-                        s_q: m.s_q,
-                    },
-                    None => MrtRates::standard(tau),
-                };
-                for (f, v) in [
-                    ("lbm.mrt.s_e", r.s_e),
-                    ("lbm.mrt.s_eps", r.s_eps),
-                    ("lbm.mrt.s_q", r.s_q),
-                ] {
-                    if !(v > 0.0 && v < 2.0) {
-                        return Err(Error::config(
-                            f,
-                            format!("relaxation rate {v} must lie in (0, 2)"),
-                        ));
-                    }
-                }
-                Some(r)
-            }
-        };
+        let mrt = MrtSpec::resolve(self.lbm.mrt, self.lbm.collision, tau, "lbm")?;
         for (k, ob) in self.obstacles.iter().enumerate() {
             let field = format!("obstacles[{k}]");
             match ob {

@@ -104,8 +104,9 @@ pub struct CouplingSpec {
     /// `"bgk"` or `"mrt"`.
     pub collision: CollisionKind,
     /// MRT rates of the non-hydrodynamic moments `{ s_e, s_eps, s_q }`; absent:
-    /// [`crate::lbm::MrtRates::standard`] (s_q from the magic Λ = 3/16, which near τ = ½ leaves the
-    /// energy fluxes almost unrelaxed: s_q = 0.020 at τ = 0.5038). Only with `"mrt"`.
+    /// [`crate::lbm::MrtRates::standard`] (s_q from the magic Λ = 3/16, which near τ = ½
+    /// leaves the energy fluxes almost unrelaxed: s_q = 0.020 at τ = 0.5038). Only with
+    /// `"mrt"`.
     pub mrt: Option<MrtSpec>,
     /// Smagorinsky constant C_s (seed eq. 5.38); absent: no LES.
     pub smagorinsky: Option<f64>,

@@ -15,7 +15,7 @@
 use std::path::Path;
 
 use granflow::io::write_svg;
-use granflow::validate::{Plot, Series};
+use granflow::report::{Plot, Series};
 
 /// Columns `names` of a CSV file, by header name.
 fn columns(path: &Path, names: &[&str]) -> Vec<Vec<f64>> {

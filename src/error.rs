@@ -60,6 +60,19 @@ impl Error {
         }
     }
 
+    /// The same error with a [`Error::Config`] field put inside `table` (`lambda` in `time`
+    /// is `time.lambda`): a solver names its own parameter, the scenario says where it sits
+    /// in the file. Other errors are returned unchanged.
+    pub fn within(self, table: &str) -> Self {
+        match self {
+            Error::Config { field, reason } => Error::Config {
+                field: format!("{table}.{field}"),
+                reason,
+            },
+            other => other,
+        }
+    }
+
     /// Shorthand for [`Error::Io`].
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {

@@ -1,9 +1,15 @@
 //! The [`Scale`] trait: how the solvers meet.
 //!
-//! Each solver (LBM fluid now; DEM grains and GIMPM continuum later) is a `Scale`: a thing with
-//! its own clock that can be advanced, observed and snapshotted. Solvers never name each other;
-//! all mapping between scales lives in a coupling driver. The verbs follow MUSCLE3's submodel
-//! loop (init → (observe → advance)* → final) and preCICE's participant.
+//! Each solver (the LBM fluid with its coupled solids, the DEM grains, the GIMPM continuum) is a
+//! `Scale`: a thing with its own clock that can be advanced, observed and snapshotted. Solvers
+//! never name each other; all mapping between scales lives in `crate::coupling`. The verbs
+//! follow MUSCLE3's submodel loop (init → (observe → advance)* → final) and preCICE's
+//! participant.
+//!
+//! Time steps have one meaning throughout: [`Scale::max_dt`] is the step the scale takes (the
+//! LBM's lattice step, the DEM's Δt_D = λ·Δt_cr or the smaller one a scenario gives, the MPM's
+//! CFL step), and anything longer is covered in the sub-steps of [`substeps`], the one
+//! sub-cycling rule (used by the scales' own `advance` and by the coupling driver).
 
 use crate::Result;
 
@@ -18,7 +24,9 @@ pub trait Scale {
 
     /// Current simulated time in seconds.
     fn time(&self) -> f64;
-    /// Largest stable step in seconds (LBM: the lattice step; DEM: λ·Δt_cr; MPM: CFL step).
+    /// The step the scale takes, in seconds: the largest it can take stably and the one it
+    /// uses (LBM: the lattice step; DEM: λ·Δt_cr, or the smaller step a scenario gives; MPM:
+    /// the CFL step, or the smaller given one).
     fn max_dt(&self) -> f64;
     /// Advance by `dt` seconds with `input` held fixed; a scale may sub-step internally.
     fn advance(&mut self, input: &Self::Input, dt: f64) -> Result<()>;
@@ -38,6 +46,9 @@ pub trait Scale {
 ///
 /// n = ⌈dt / max_dt⌉ (at least 1), each of size dt / n. A relative slack of 1e-9 keeps
 /// `dt = k·max_dt` from producing k + 1 steps through round-off.
+///
+/// This is seed eq. 5.61's n_s = ⌊Δt/Δt_D⌋ + 1 wherever Δt/Δt_D is not a whole number; at a
+/// whole number k the seed's rule takes k + 1 steps where k already keep Δt_s ≤ Δt_D.
 pub fn substeps(dt: f64, max_dt: f64) -> (u64, f64) {
     let n = ((dt / max_dt) * (1.0 - 1e-9)).ceil().max(1.0) as u64;
     (n, dt / n as f64)

@@ -1,9 +1,11 @@
 //! Fluid–grain coupling (issue 6): the validation cases at test fidelity, and the PSM step's
 //! equivalence with the plain fluid step when no solid is present.
 
-use granflow::lbm::{Collider, CollisionModel, Edge, Edges, Lattice, Lbm, MrtRates, Obstacles};
+use granflow::coupling::CoupledFluid;
+use granflow::lbm::{CollisionModel, Edge, Edges, FluidModel, Lattice, Lbm, MrtRates, Obstacles};
+use granflow::report::Fidelity;
+use granflow::scenario::validation::run;
 use granflow::units::Units;
-use granflow::validate::{run, Fidelity};
 
 fn assert_passes(case: &str) {
     let report = run(case, Fidelity::Test).expect(case);
@@ -66,26 +68,34 @@ fn zero_weight_matches_plain<T: granflow::lbm::Real>(model: CollisionModel, les:
                 0.003,
             )
         });
-        Lbm::new(
+        CoupledFluid::new(Lbm::new(
             lat,
-            Collider::new(model, 0.7, les, [1e-5, -2e-5]),
+            FluidModel {
+                collision: model,
+                smagorinsky: les,
+                body_force: [1e-5, -2e-5],
+            },
             Obstacles::default(),
-            Units::new(1.0, 1.0, 1.0),
-        )
+            Units::lattice(0.7),
+        ))
     };
     let (mut plain, mut covered) = (make(), make());
     for c in (0..nx * ny).step_by(2) {
         covered.partial.push(c as u32, 0.0, [0.05, -0.05]);
     }
+    covered.exchange.resize(covered.partial.len(), [0.0; 2]);
     for _ in 0..7 {
         plain.step();
         covered.step();
     }
     for c in 0..nx * ny {
-        let (a, b) = (plain.lattice.populations(c), covered.lattice.populations(c));
+        let (a, b) = (
+            plain.lbm.lattice.populations(c),
+            covered.lbm.lattice.populations(c),
+        );
         assert_eq!(a, b, "cell {c}");
     }
-    assert!(covered.partial.exchange.iter().all(|e| *e == [0.0, 0.0]));
+    assert!(covered.exchange.iter().all(|e| *e == [0.0, 0.0]));
 }
 
 #[test]

@@ -1,11 +1,12 @@
 //! Ladd's modified bounce-back coupling (issue 6, seed eq. 5.45–5.49): the validation cases
 //! at test fidelity, and the selectable map in the same coupled driver as PSM.
 
-use granflow::coupling::{Coupled, Grid, LaddMap};
+use granflow::coupling::{Coupled, CoupledFluid, Grid, LaddMap};
 use granflow::dem::{ContactParams, Dem, DemParams, Grains};
-use granflow::lbm::{Collider, CollisionModel, Edges, Lattice, Lbm, MrtRates, Obstacles};
+use granflow::lbm::{CollisionModel, Edges, FluidModel, Lattice, Lbm, MrtRates, Obstacles};
+use granflow::report::Fidelity;
+use granflow::scenario::validation::run;
 use granflow::units::Units;
-use granflow::validate::{run, Fidelity};
 
 fn assert_passes(case: &str) {
     let report = run(case, Fidelity::Test).expect(case);
@@ -59,17 +60,16 @@ fn ladd_f32_mrt_les_in_the_driver() {
         top: wall,
     };
     let lat = Lattice::<f32>::new(nx, ny, edges, vec![false; nx * ny]).unwrap();
-    let fluid = Lbm::new(
+    let fluid = CoupledFluid::new(Lbm::new(
         lat,
-        Collider::new(
-            CollisionModel::Mrt(MrtRates::standard(0.6)),
-            0.6,
-            Some(0.1),
-            [0.0; 2],
-        ),
+        FluidModel {
+            collision: CollisionModel::Mrt(MrtRates::standard(0.6)),
+            smagorinsky: Some(0.1),
+            body_force: [0.0; 2],
+        },
         Obstacles::default(),
-        Units::new(1.0, 1.0, 1.0),
-    );
+        Units::lattice(0.6),
+    ));
     let mut g = Grains::new();
     g.push_disk(14.0, 20.0, 5.0, 2.0);
     g.vx[0] = 0.03;
@@ -91,7 +91,7 @@ fn ladd_f32_mrt_les_in_the_driver() {
     for _ in 0..300 {
         c.step().unwrap();
     }
-    granflow::lbm::Fluid::check_stable(&c.fluid, 0.3).unwrap();
+    granflow::lbm::Fluid::check_stable(&c.fluid.lbm, 0.3).unwrap();
     let gr = &c.solid.grains;
     println!(
         "x − x0 = {}, vx = {}, ω = {}",

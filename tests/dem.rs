@@ -1,12 +1,12 @@
 //! DEM validation: restitution, incline, conservation, energy budget, time-step refusal,
-//! packing. Tolerances and their sources are in `granflow::dem::validation`.
+//! packing. Tolerances and their sources are in `granflow::scenario::dem::validation`.
 
 use granflow::dem::packing::{
     deposit_column, hex_block, with_friction, ColumnSpec, SizeDistribution,
 };
-use granflow::dem::validation;
 use granflow::dem::{ContactParams, Dem, DemParams, Grains, Wall};
-use granflow::validate::{Check, Fidelity};
+use granflow::report::{Check, Fidelity};
+use granflow::scenario::dem::validation;
 
 fn assert_all(checks: &[Check]) {
     for c in checks {
@@ -338,7 +338,7 @@ fn results_independent_of_thread_count() {
             .build()
             .unwrap();
         pool.install(|| {
-            let base = granflow::dem::bench::system(2500, 7).unwrap();
+            let base = granflow::scenario::dem::bench::system(2500, 7).unwrap();
             let mut dem = if shuffle {
                 let g0 = &base.grains;
                 let n = g0.len();
@@ -401,9 +401,9 @@ fn a_run_of_steps_equals_single_steps() {
         v.extend([e.total(), e.dissipated()].map(f64::to_bits));
         v
     };
-    let mut run = granflow::dem::bench::system(2500, 7).unwrap();
+    let mut run = granflow::scenario::dem::bench::system(2500, 7).unwrap();
     run.steps(1600);
-    let mut single = granflow::dem::bench::system(2500, 7).unwrap();
+    let mut single = granflow::scenario::dem::bench::system(2500, 7).unwrap();
     for _ in 0..1600 {
         single.step();
     }

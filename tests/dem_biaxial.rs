@@ -1,10 +1,11 @@
-//! Biaxial test of the collapse models' DEM material (`granflow::dem::biaxial`), 300 grains
+//! Biaxial test of the collapse models' DEM material (`granflow::scenario::dem::biaxial`), 300 grains
 //! at σ₃ = 1 kPa, I = 10⁻³, to ε₁ = 0.3: a loose sample (deposited with the grains' friction,
 //! as the collapse columns) and a dense one (deposited frictionless), ≈ 15 s each, run side by
 //! side.
 
-use granflow::dem::biaxial::{run_biaxial, BiaxialResult, BiaxialSpec};
-use granflow::dem::scenario::DemScenario;
+use granflow::scenario::dem::biaxial::{run_biaxial, BiaxialResult, BiaxialSpec};
+use granflow::scenario::dem::DemScenario;
+use granflow::scenario::ScenarioFile;
 
 fn sample(prep_friction: f64) -> BiaxialResult {
     let path =

@@ -2,13 +2,13 @@
 //! random disk packings, the detector chosen per pair type, and polygon physics (resting
 //! square, frictional incline, momentum in a polygon–polygon collision, disk on a polygon
 //! wall, energy budget of a mixed pile). Measurements and tolerances (with their sources) are
-//! in `granflow::dem::validation_polygon`.
+//! in `granflow::scenario::dem::validation_polygon`.
 
 use granflow::dem::detect_rapier::{Coverage, RapierDetector};
 use granflow::dem::packing::SplitMix64;
 use granflow::dem::shape::Polygons;
-use granflow::dem::validation_polygon::{self as vp, random_packing, test_walls};
 use granflow::dem::{ContactParams, Dem, DemParams, Grains, Wall};
+use granflow::scenario::dem::validation_polygon::{self as vp, random_packing, test_walls};
 
 /// The property test of issue 3: on random disk packings (5 seeds of 500 polydisperse disks,
 /// overlapping each other and the walls) rapier's collision pipeline and the cell list find the

@@ -4,8 +4,9 @@
 
 use std::path::Path;
 
-use granflow::dem::run::run_column_collapse;
-use granflow::dem::scenario::DemScenario;
+use granflow::scenario::collapse::dem::run_column_collapse;
+use granflow::scenario::dem::DemScenario;
+use granflow::scenario::ScenarioFile;
 
 fn models() -> Vec<std::path::PathBuf> {
     let mut v: Vec<_> = std::fs::read_dir("models/column_collapse")

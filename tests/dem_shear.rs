@@ -1,10 +1,11 @@
 //! The periodic simple-shear cell (`granflow::dem::shear_cell`) and the μ(I) test built on it
-//! (`granflow::dem::mu_i`).
+//! (`granflow::scenario::dem::shear`).
 
 use granflow::dem::contact::ContactParams;
-use granflow::dem::mu_i::{fit_mu_i, run_shear, ShearResult, ShearSpec};
-use granflow::dem::scenario::DemScenario;
 use granflow::dem::shear_cell::Cell;
+use granflow::scenario::dem::shear::{fit_mu_i, run_shear, ShearResult, ShearSpec};
+use granflow::scenario::dem::DemScenario;
+use granflow::scenario::ScenarioFile;
 
 const K: f64 = 1.6e4;
 const T: f64 = 1e-3;

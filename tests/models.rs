@@ -2,7 +2,8 @@
 
 use std::path::Path;
 
-use granflow::config::Scenario;
+use granflow::scenario::fluid::Scenario;
+use granflow::scenario::ScenarioFile;
 
 fn toml_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
     for e in std::fs::read_dir(dir).unwrap() {

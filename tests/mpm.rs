@@ -3,9 +3,11 @@
 
 use std::path::Path;
 
-use granflow::mpm::scenario::MpmScenario;
 use granflow::mpm::Transfer;
-use granflow::validate::{run, Fidelity};
+use granflow::report::Fidelity;
+use granflow::scenario::mpm::MpmScenario;
+use granflow::scenario::validation::run;
+use granflow::scenario::ScenarioFile;
 
 fn case_passes(name: &str) {
     let r = run(name, Fidelity::Test).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -47,7 +49,7 @@ fn collapse_models_parse_and_match_the_dem_geometry() {
     for a in ["0.5", "1", "2", "4", "6"] {
         let s = MpmScenario::from_file(&model(a)).unwrap_or_else(|e| panic!("a={a}: {e}"));
         let d = s.derive().unwrap_or_else(|e| panic!("a={a}: {e}"));
-        let dem = granflow::dem::scenario::DemScenario::from_file(
+        let dem = granflow::scenario::dem::DemScenario::from_file(
             &Path::new(env!("CARGO_MANIFEST_DIR"))
                 .join(format!("models/column_collapse/dem_a{a}.toml")),
         )
@@ -168,7 +170,8 @@ fn short_collapse_writes_the_output_contract() {
     let text = std::fs::read_to_string(model("2")).unwrap();
     let s = MpmScenario::from_toml(&text.replace("end_tc = 15.0", "end_tc = 0.5")).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let r = granflow::mpm::run::run_column_collapse(&s, dir.path(), &mut |_, _| {}).unwrap();
+    let r = granflow::scenario::collapse::mpm::run_column_collapse(&s, dir.path(), &mut |_, _| {})
+        .unwrap();
     let c = &r.collapse;
     assert!(!c.at_rest && c.l_f > 1.05 * c.l_i, "{r:?}");
     let json: serde_json::Value =
@@ -218,7 +221,8 @@ fn short_collapse_writes_the_output_contract() {
 #[test]
 fn scale_advances_in_substeps_and_restores() {
     use granflow::scale::Scale;
-    let mut mpm = granflow::mpm::bench::column(512, granflow::mpm::ShapeKind::Gimp).unwrap();
+    let mut mpm =
+        granflow::scenario::mpm::bench::column(512, granflow::mpm::ShapeKind::Gimp).unwrap();
     let dt = mpm.max_dt();
     let snap = mpm.snapshot();
     mpm.advance(&(), 10.5 * dt).unwrap();
@@ -237,20 +241,21 @@ fn scale_advances_in_substeps_and_restores() {
 /// but is the front; a point in a cell touching the mass is attached.
 #[test]
 fn runout_counts_only_points_attached_to_the_main_mass() {
-    let mut mpm = granflow::mpm::bench::column(512, granflow::mpm::ShapeKind::Gimp).unwrap();
+    let mut mpm =
+        granflow::scenario::mpm::bench::column(512, granflow::mpm::ShapeKind::Gimp).unwrap();
     let h = mpm.grid.h;
-    let s0 = granflow::mpm::run::shape(&mpm);
+    let s0 = granflow::scenario::collapse::mpm::shape(&mpm);
     let right = mpm.points.pos.iter().fold(0.0f64, |a, p| a.max(p[0]));
     // Two cells beyond the mass's last occupied cell: detached.
     mpm.points.pos.push([right + 2.5 * h, 0.25 * h]);
     mpm.points.half_size.push(0.25 * h);
-    let s1 = granflow::mpm::run::shape(&mpm);
+    let s1 = granflow::scenario::collapse::mpm::shape(&mpm);
     assert_eq!(s1.runout, s0.runout);
     assert!((s1.front - (right + 2.75 * h)).abs() < 1e-12);
     // One cell beyond: its cell shares an edge with an occupied cell, so attached.
     mpm.points.pos.push([right + 1.0 * h, 0.25 * h]);
     mpm.points.half_size.push(0.25 * h);
-    let s2 = granflow::mpm::run::shape(&mpm);
+    let s2 = granflow::scenario::collapse::mpm::shape(&mpm);
     assert!((s2.runout - (right + 1.25 * h)).abs() < 1e-12, "{s2:?}");
 }
 

@@ -8,9 +8,10 @@
 
 use std::path::Path;
 
-use granflow::coupling::run::run_submerged;
-use granflow::coupling::scenario::SubmergedScenario;
-use granflow::dem::scenario::DemScenario;
+use granflow::scenario::collapse::submerged::run_submerged;
+use granflow::scenario::dem::DemScenario;
+use granflow::scenario::submerged::SubmergedScenario;
+use granflow::scenario::ScenarioFile;
 use vtkio::model::{Attribute, DataSet, Piece};
 use vtkio::Vtk;
 
@@ -261,7 +262,8 @@ fn tiny_collapse_runs_and_its_outputs_agree() {
     let dry_dir = tempfile::tempdir().unwrap();
     let mut dry = s.dem_part();
     dry.time.end_tc = 1.6;
-    granflow::dem::run::run_column_collapse(&dry, dry_dir.path(), &mut |_, _| {}).unwrap();
+    granflow::scenario::collapse::dem::run_column_collapse(&dry, dry_dir.path(), &mut |_, _| {})
+        .unwrap();
     let dcsv = std::fs::read_to_string(dry_dir.path().join("timeseries.csv")).unwrap();
     let at = |rows: &mut dyn Iterator<Item = Vec<f64>>, tc: usize, l: usize| -> f64 {
         rows.min_by(|a, b| {
@@ -327,8 +329,8 @@ fn cli_check_routes_submerged_files() {
 #[test]
 fn f32_bgk_les_variant_runs() {
     let mut s = tiny();
-    s.coupling.precision = granflow::config::Precision::F32;
-    s.coupling.collision = granflow::config::CollisionKind::Bgk;
+    s.coupling.precision = granflow::scenario::fluid::Precision::F32;
+    s.coupling.collision = granflow::scenario::fluid::CollisionKind::Bgk;
     s.coupling.smagorinsky = Some(0.1);
     s.time.end_tc = 0.5;
     let dir = tempfile::tempdir().unwrap();
@@ -407,7 +409,7 @@ fn mrt_rates_come_from_the_file_and_are_checked() {
 #[test]
 fn ladd_method_runs() {
     let mut s = tiny();
-    s.coupling.method = granflow::coupling::scenario::CouplingMethod::Ladd;
+    s.coupling.method = granflow::scenario::submerged::CouplingMethod::Ladd;
     s.coupling.tau = Some(0.6);
     s.time.end_tc = 0.5;
     let dir = tempfile::tempdir().unwrap();

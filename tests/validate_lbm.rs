@@ -1,14 +1,15 @@
 //! The fluid validation cases at test fidelity (the same runs as `granflow validate <case>`):
 //! Poiseuille, Taylor–Green, conservation, LES channel, Ghia cavities, Schäfer–Turek 2D-1, the
 //! Sangani–Acrivos array and the seed's shedding case. Every check of each case must pass
-//! (references and tolerances are beside each check in `src/validate/`), and every case returns
+//! (references and tolerances are beside each check in `src/scenario/fluid/validation/`), and every case returns
 //! at least one figure with data.
 
-use granflow::validate::{self, Check, Fidelity};
+use granflow::report::{Check, Fidelity};
+use granflow::scenario::validation;
 
 fn run_case(name: &str) {
     let t = std::time::Instant::now();
-    let report = validate::run(name, Fidelity::Test).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let report = validation::run(name, Fidelity::Test).unwrap_or_else(|e| panic!("{name}: {e}"));
     let checks = &report.checks;
     println!("{name}: {:.1} s", t.elapsed().as_secs_f64());
     for c in checks {

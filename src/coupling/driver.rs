@@ -4,14 +4,14 @@
 //! One coupled step of the fluid's step Δt (seed section 5.4):
 //! 1. the solid shows its bodies (`observe`), the map draws them onto the fluid's input;
 //! 2. the fluid advances Δt with them and shows the force on them;
-//! 3. the map sums those forces per body, and the solid advances Δt in
-//!    n_s = ⌊Δt/Δt_D⌋ + 1 sub-steps of Δt_s = Δt/n_s with the hydrodynamic force held
-//!    (seed eq. 5.61).
+//! 3. the map sums those forces per body, and the solid advances Δt in n_s sub-steps of
+//!    Δt_s = Δt/n_s ≤ Δt_D with the hydrodynamic force held (seed eq. 5.61), n_s by the one
+//!    sub-cycling rule of [`substeps`].
 //!
 //! The map is a [`Exchange`]; [`super::DiskCover`] maps DEM grains onto partially saturated
 //! cells. An MPM solid plugs in with its own map.
 
-use crate::scale::Scale;
+use crate::scale::{substeps, Scale};
 use crate::Result;
 
 /// Converts what one scale shows into what the other takes.
@@ -20,12 +20,6 @@ pub trait Exchange<F: Scale, S: Scale> {
     fn to_fluid(&mut self, solid: &S::Output, fluid_in: &mut F::Input);
     /// Fluid output → solid input (e.g. cell forces → force and torque per grain).
     fn to_solid(&mut self, fluid: &F::Output, solid_in: &mut S::Input);
-}
-
-/// Number of solid sub-steps per fluid step, n_s = ⌊Δt/Δt_D⌋ + 1 (seed eq. 5.61), so that
-/// Δt_s = Δt/n_s < Δt_D.
-pub fn subcycles(dt: f64, dt_solid: f64) -> u64 {
-    (dt / dt_solid).floor() as u64 + 1
 }
 
 /// A fluid and a solid scale coupled through a map `M`.
@@ -83,8 +77,7 @@ where
         self.fluid.observe(&mut self.fluid_out);
         self.map.to_solid(&self.fluid_out, &mut self.solid_in);
         self.solid.input_changed();
-        let n = subcycles(dt, self.solid.max_dt());
-        let h = dt / n as f64;
+        let (n, h) = substeps(dt, self.solid.max_dt());
         for _ in 0..n {
             self.solid.advance(&self.solid_in, h)?;
         }
@@ -101,19 +94,5 @@ where
     /// The fluid input of the last step (e.g. the covered cells).
     pub fn fluid_input(&self) -> &F::Input {
         &self.fluid_in
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn subcycles_follow_eq_5_61() {
-        assert_eq!(subcycles(1.0, 0.3), 4);
-        // An exact multiple still takes one more (the floor + 1 of the seed).
-        assert_eq!(subcycles(1.0, 0.25), 5);
-        assert_eq!(subcycles(1.0, 2.0), 1);
-        assert!(1.0 / subcycles(1.0, 0.3) as f64 <= 0.3);
     }
 }

@@ -1,37 +1,32 @@
-//! Fluid–grain coupling (seed section 5.4): the LBM fluid and a solid scale (DEM grains now,
-//! MPM later) advanced together.
+//! Couplings between the scales: every map from one solver to another lives here, and no
+//! solver names another.
 //!
-//! * [`overlap`]: exact disk–square overlap area, the solid fraction ε of a lattice cell.
-//! * [`cover`]: grains → partially saturated cells (ε, solid velocity with rotation,
-//!   hydrodynamic radius factor r/R) and cell forces → force and torque per grain
-//!   (seed eq. 5.53–5.54). The collision of covered cells is in [`crate::lbm::partial`].
-//! * [`ladd`]: grains → boundary links for Ladd's modified bounce-back (seed eq. 5.45–5.49),
-//!   the alternative to partially saturated cells; link forces → force and torque per grain.
-//! * [`scenario`], [`run`]: the submerged column collapse (TOML with `[fluid]` and
-//!   `[coupling]` tables, `granflow check` / `granflow run`).
-//! * [`driver`]: the coupled step over two [`crate::scale::Scale`]s with solid sub-cycling
-//!   n_s = ⌊Δt/Δt_D⌋ + 1 and the hydrodynamic force held (seed eq. 5.61).
+//! Fluid ↔ solid (seed section 5.4): the LBM fluid and a solid scale (DEM grains now, MPM
+//! points later) advanced together.
+//!
+//! * [`fluid`]: [`CoupledFluid`], the LBM with the coupling methods' state, as the fluid
+//!   [`Scale`] whose input is what the solids cover ([`SolidCover`]) and whose output is the
+//!   force on them ([`CellForces`]);
+//! * [`psm`]: partially saturated cells (Noble–Torczynski), the whole method;
+//! * [`ladd`]: Ladd's modified bounce-back, the whole method;
+//! * [`driver`]: the coupled step over two [`Scale`]s, with the solid sub-cycled by the one
+//!   rule of [`crate::scale::substeps`] and the hydrodynamic force held (seed eq. 5.61).
 //!
 //! Buoyancy enters through reduced gravity (1 − ρ_f/ρ_s) g on the grains (seed eq. 5.57); the
 //! fluid then carries no gravity, so there is no hydrostatic pressure to resolve.
 
-pub mod bench;
-pub mod cover;
 pub mod driver;
+pub mod fluid;
 pub mod ladd;
-pub mod overlap;
-pub mod run;
-pub mod scenario;
-pub mod validation;
-pub mod validation_ladd;
+pub mod psm;
 
-pub use cover::{DiskCover, Grid};
-pub use driver::{subcycles, Coupled, Exchange};
+pub use driver::{Coupled, Exchange};
+pub use fluid::{CellForces, CoupledFluid, SolidCover};
 pub use ladd::LaddMap;
+pub use psm::{DiskCover, Grid};
 
 use crate::dem::scale::GrainView;
 use crate::dem::ExternalLoads;
-use crate::lbm::{CellForces, SolidCover};
 use crate::scale::Scale;
 
 /// Reduced gravity (1 − ρ_f/ρ_s) g for grains of density ρ_s in a fluid of density ρ_f

@@ -13,7 +13,7 @@
 //!
 //! **Normal stress.** The height follows a first-order (Berendsen et al. 1984) barostat on the
 //! measured σ_yy: each step L_y and every y are scaled by 1 + ε̇_yy Δt with
-//! ε̇_yy = β γ̇ (σ_yy − P)/P, β = 0.3, capped at |ε̇_yy| ≤ γ̇ ([`crate::dem::mu_i`]). The gain
+//! ε̇_yy = β γ̇ (σ_yy − P)/P, β = 0.3, capped at |ε̇_yy| ≤ γ̇ ([`crate::scenario::dem::shear`]). The gain
 //! is constant, so a stationary height (⟨ε̇_yy⟩ = 0) means ⟨σ_yy⟩ = P. Gains that follow the
 //! state bias the mean: with the contact network's affine stiffness in the gain, the jammed
 //! phases (high σ_yy, stiff) relax slower than the loose ones, and σ_yy settled at 1.3 P at
@@ -38,7 +38,6 @@
 //! flow's own relative shift γ̇ r_c t over the cut-off r_c, exceeds the skin.
 
 use super::contact::{ContactParams, ContactState, Law, Motion};
-use super::mu_i::ShearPoint;
 
 /// The periodic cell and its grains (structure of arrays).
 pub struct Cell {
@@ -438,4 +437,40 @@ fn min_image(dx: f64, dy: f64, lx: f64, ly: f64, offset: f64) -> (f64, f64, f64)
     let dy = dy + ky * ly;
     let dx = dx + ky * offset;
     (dx - lx * (dx / lx).round(), dy, ky)
+}
+
+/// A block mean of the recorded quantities.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct ShearPoint {
+    /// Shear strain γ̇ t at the end of the block.
+    pub strain: f64,
+    /// σ_xx, σ_yy (Pa), τ = −½(σ_xy + σ_yx) (Pa).
+    pub sigma_xx: f64,
+    /// See `sigma_xx`.
+    pub sigma_yy: f64,
+    /// See `sigma_xx`.
+    pub tau: f64,
+    /// Solid fraction Σ πr²/(L_x L_y).
+    pub packing_fraction: f64,
+    /// Contacts per grain.
+    pub coordination: f64,
+}
+
+impl ShearPoint {
+    pub(crate) fn add(&mut self, o: &ShearPoint, w: f64) {
+        self.sigma_xx += w * o.sigma_xx;
+        self.sigma_yy += w * o.sigma_yy;
+        self.tau += w * o.tau;
+        self.packing_fraction += w * o.packing_fraction;
+        self.coordination += w * o.coordination;
+    }
+    /// μ = τ/σ_yy.
+    pub fn mu(&self) -> f64 {
+        self.tau / self.sigma_yy
+    }
+    /// Mohr–Coulomb sin φ = √(((σ_xx − σ_yy)/2)² + τ²)/((σ_xx + σ_yy)/2).
+    pub fn sin_phi(&self) -> f64 {
+        let h = 0.5 * (self.sigma_xx - self.sigma_yy);
+        (h * h + self.tau * self.tau).sqrt() / (0.5 * (self.sigma_xx + self.sigma_yy))
+    }
 }

@@ -29,16 +29,18 @@
 //! same forces, so they are one pass over the grains (the events of each grain applied in the
 //! same order as the serial loop would: the results are bit for bit those of single steps).
 //!
-//! Time step: seed eq. 5.59–5.60, Δt = λ Δt_cr with λ = 0.1 by default; see [`critical_step`].
+//! Time step: seed eq. 5.59–5.60, Δt = λ Δt_cr with λ = 0.1 by default, derived in one place,
+//! [`super::time_step::TimeStep`].
 
 use rayon::prelude::*;
 
-use super::contact::{self, ContactOut, ContactParams, ContactState, Event, Law, Motion};
+use super::contact::{ContactOut, ContactParams, ContactState, Event, Law, Motion};
 use super::detect_rapier::RapierDetector;
 use super::energy::Energy;
 use super::grains::Grains;
 use super::neighbours::{Detector, PairList, WallList, PAIR_TOUCHING};
 use super::shape_contacts::{ShapeContacts, ShapeSums};
+use super::time_step::TimeStep;
 use super::walls::Wall;
 use crate::{Error, Result};
 
@@ -80,45 +82,6 @@ impl DemParams {
             global_damping: 0.0,
         }
     }
-}
-
-/// Critical time step of the system: seed eq. 5.59, Δt_cr = 2(√(1 + ξ²) − ξ)/ω, taken as the
-/// smallest over the springs present, each with the inertia it moves:
-/// * normal, grain–grain and grain–wall: ω = √(k_n/m_min) (the seed's choice), ξ the normal
-///   damping ratio (from e, plus γ_n m_min/(2√(k_n m_min)));
-/// * tangential: ω = √(3k_t/m_min) — the contact point of a disk (J = ½mR²) has effective mass
-///   m/3 — with ξ = 0;
-/// * rolling: ω = √(k_r/J_min), ξ = 0.
-///
-/// Returns ∞ if there are no grains.
-pub fn critical_step(p: &DemParams, m_min: f64, j_min: f64) -> f64 {
-    if !m_min.is_finite() {
-        return f64::INFINITY;
-    }
-    let mut dt = f64::INFINITY;
-    for c in [&p.grain, &p.wall] {
-        let xi = c.damping_ratio() + c.gamma_n * m_min / (2.0 * (c.k_n * m_min).sqrt());
-        dt = dt.min(contact::critical_step(c.k_n, m_min, xi));
-        if c.k_t > 0.0 {
-            dt = dt.min(contact::critical_step(3.0 * c.k_t, m_min, 0.0));
-        }
-        if c.rolling_stiffness > 0.0 {
-            dt = dt.min(contact::critical_step(c.rolling_stiffness, j_min, 0.0));
-        }
-    }
-    dt
-}
-
-/// Smallest effective mass of a polygon grain at a contact point (∞ if none):
-/// m_c = 1/(1/m + R_b²/J), R_b the bounding radius — a point on a rotating body is lighter than
-/// its mass (a disk's contact point has m/3 tangentially, which [`critical_step`] already
-/// builds in through 3k_t). Passed as m_min for polygons, it makes the normal and tangential
-/// critical steps conservative.
-fn polygon_contact_mass(g: &Grains) -> f64 {
-    (0..g.len())
-        .filter(|&i| !g.is_disk(i))
-        .map(|i| 1.0 / (1.0 / g.mass[i] + g.radius[i] * g.radius[i] / g.inertia[i]))
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// External loads held during [`Dem::advance_with`] (e.g. hydrodynamic force and torque from
@@ -290,12 +253,6 @@ impl Dem {
         if !params.gravity.iter().all(|g| g.is_finite()) {
             return Err(Error::config("dem.gravity", "must be finite"));
         }
-        if !(params.lambda > 0.0 && params.lambda <= 1.0) {
-            return Err(Error::config(
-                "dem.lambda",
-                format!("must be in (0, 1], got {}", params.lambda),
-            ));
-        }
         if !(params.skin_fraction > 0.0 && params.skin_fraction.is_finite()) {
             return Err(Error::config(
                 "dem.skin_fraction",
@@ -326,35 +283,10 @@ impl Dem {
                 ));
             }
         }
-        let dt_cr = critical_step(
-            &params,
-            grains.min_mass().min(polygon_contact_mass(&grains)),
-            grains.min_inertia(),
-        );
-        let dt_max = params.lambda * dt_cr;
-        let dt = match params.dt {
-            Some(dt) if !(dt > 0.0 && dt.is_finite()) => {
-                return Err(Error::config("dem.dt", format!("must be > 0, got {dt}")));
-            }
-            Some(dt) if dt > dt_max * (1.0 + 1e-12) => {
-                return Err(Error::config(
-                    "dem.dt",
-                    format!(
-                        "Δt = {dt:.4e} s exceeds λ·Δt_cr = {dt_max:.4e} s (Δt_cr = {dt_cr:.4e} s by seed eq. 5.59, λ = {}); \
-                         use at most {dt_max:.4e} s",
-                        params.lambda
-                    ),
-                ));
-            }
-            Some(dt) => dt,
-            None if dt_max.is_finite() => dt_max,
-            None => {
-                return Err(Error::config(
-                    "dem.dt",
-                    "no grains: give the step explicitly",
-                ))
-            }
-        };
+        let TimeStep {
+            critical: dt_cr,
+            dt,
+        } = TimeStep::of_grains(&params, &grains).map_err(|e| e.within("dem"))?;
         let skin = params.skin_fraction * 2.0 * grains.max_radius().max(f64::MIN_POSITIVE);
         let shapes = RapierDetector::needed(&grains, &walls).then(|| ShapeContacts::new(skin));
         Ok(Dem {
@@ -441,14 +373,9 @@ impl Dem {
         self.dt
     }
 
-    /// Critical step Δt_cr of seed eq. 5.59 (s), see [`critical_step`].
+    /// Critical step Δt_cr of seed eq. 5.59 (s), see [`super::time_step::critical_step`].
     pub fn critical_dt(&self) -> f64 {
         self.dt_cr
-    }
-
-    /// Largest step allowed, λ Δt_cr.
-    pub fn max_dt(&self) -> f64 {
-        self.params.lambda * self.dt_cr
     }
 
     /// The parameters.

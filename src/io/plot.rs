@@ -10,7 +10,7 @@ use std::ops::Range;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::prelude::*;
 
-use crate::validate::{Plot, Style};
+use crate::report::{Plot, Style};
 use crate::{Error, Result};
 
 /// Figure size in pixels.

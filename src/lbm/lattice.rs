@@ -21,8 +21,8 @@ use rayon::prelude::*;
 
 use super::boundary::{zou_he, Edge, Edges, Neighbour, ZouHe, ZouHeNode};
 use super::collision::Collider;
+use super::covered::CoveredCells;
 use super::d2q9::{equilibrium, CX, CY, OPP, Q, W};
-use super::partial::{self, PartialCells};
 use super::real::Real;
 
 /// Nodes collided together as the lanes of one vector in the special-node path.
@@ -93,6 +93,9 @@ pub struct Lattice<T> {
     /// Half the body force, F/2 (lattice units), by which the Zou–He closure shifts the
     /// momentum it imposes: with Guo forcing the velocity is u = (Σ f e + F/2)/ρ.
     zh_shift: [f64; 2],
+    /// Index of the first covered cell of each row (ny + 1 values), scratch of
+    /// [`Lattice::step_covered`].
+    covered_rows: Vec<u32>,
 }
 
 /// A raw pointer that may cross threads; see the SAFETY notes where it is dereferenced.
@@ -154,6 +157,7 @@ impl<T: Real> Lattice<T> {
             special_of: vec![u32::MAX; n],
             even: true,
             zh_shift: [0.0; 2],
+            covered_rows: Vec::new(),
         };
         lat.plan();
         lat.fill(|_, _| (1.0, 0.0, 0.0));
@@ -432,31 +436,60 @@ impl<T: Real> Lattice<T> {
         self.even = !even;
     }
 
-    /// One fused stream–collide step in which the cells of `psm` collide as partially
-    /// saturated cells ([`super::partial`]) and record the momentum exchanged with the solid in
-    /// `psm.exchange`. Streaming is unchanged: a covered cell streams like the fluid node it is.
-    /// With no covered cells this is [`Lattice::step`].
-    pub fn step_partial(&mut self, collider: &Collider<T>, psm: &mut PartialCells<T>) {
-        if psm.is_empty() {
+    /// One fused stream–collide step in which the cells of `psm` collide with the term of a
+    /// coupling method ([`CoveredCells::apply`] after the fluid collision) and store the
+    /// momentum that term gave the fluid in `exchange` (one entry per covered cell; entries
+    /// of solid cells are left alone). Streaming is unchanged: a covered cell streams like
+    /// the fluid node it is. With no covered cells this is [`Lattice::step`].
+    ///
+    /// # Panics
+    /// If the cells are not ascending and unique, lie outside the lattice, or `exchange` has
+    /// another length.
+    pub fn step_covered<C: CoveredCells<T>>(
+        &mut self,
+        collider: &Collider<T>,
+        psm: &C,
+        exchange: &mut [[f64; 2]],
+    ) {
+        let cells = psm.cells();
+        if cells.is_empty() {
             return self.step(collider);
         }
-        psm.index_rows(self.nx, self.ny);
+        assert!(
+            cells.par_windows(2).all(|w| w[0] < w[1]),
+            "covered cells must be ascending and unique"
+        );
+        assert!(
+            cells
+                .last()
+                .is_none_or(|&c| (c as usize) < self.nx * self.ny),
+            "covered cell outside the lattice"
+        );
+        assert_eq!(
+            exchange.len(),
+            cells.len(),
+            "one exchange entry per covered cell"
+        );
         let (nx, ny, n, even) = (self.nx, self.ny, self.stride, self.even);
+        let row_start = &mut self.covered_rows;
+        row_start.clear();
+        row_start
+            .extend((0..=ny).map(|y| cells.partition_point(|&c| (c as usize) < y * nx) as u32));
         self.zh_shift = [0.5 * collider.force[0], 0.5 * collider.force[1]];
         let zh_shift = self.zh_shift;
         let base = Shared(self.f.as_mut_ptr());
-        let exchange = Shared(psm.exchange.as_mut_ptr());
+        let exchange = Shared(exchange.as_mut_ptr());
         let (specials, special_of, solid) = (&self.specials, &self.special_of, &self.solid);
         let wall_corr = &self.wall_corr;
-        let psm = &*psm;
+        let row_start = &self.covered_rows;
         self.rows.par_iter().enumerate().for_each(|(y, plan)| {
             let (runs, group_list) = if even {
                 (&plan.even_runs, &plan.even_specials)
             } else {
                 (&plan.runs, &plan.specials)
             };
-            let (k0, k1) = (psm.row_start[y] as usize, psm.row_start[y + 1] as usize);
-            let covered = &psm.cells[k0..k1];
+            let (k0, k1) = (row_start[y] as usize, row_start[y + 1] as usize);
+            let covered = &cells[k0..k1];
             let is_covered = |c: u32| covered.binary_search(&c).is_ok();
             let row = (y * nx) as u32;
             let bulk = |x0: usize, x1: usize| {
@@ -527,17 +560,17 @@ impl<T: Real> Lattice<T> {
                 };
             }
             // Covered bulk nodes: stretches of consecutive cells take the vector path with
-            // the partially saturated blend.
+            // the covered-cell term.
             let mut k = k0;
             while k < k1 {
-                let c = psm.cells[k] as usize;
+                let c = cells[k] as usize;
                 if solid[c] || special_of[c] != u32::MAX {
                     k += 1;
                     continue;
                 }
                 let mut e = k + 1;
                 while e < k1 {
-                    let ce = psm.cells[e] as usize;
+                    let ce = cells[e] as usize;
                     if ce != c + (e - k) || solid[ce] || special_of[ce] != u32::MAX {
                         break;
                     }
@@ -546,7 +579,7 @@ impl<T: Real> Lattice<T> {
                 let x0 = c - y * nx;
                 // SAFETY: as in `step`; entries k..e of `exchange` belong to this row.
                 unsafe {
-                    bulk_run_psm::<T, PSM_LANES>(
+                    bulk_run_psm::<T, C, PSM_LANES>(
                         base.get(),
                         n,
                         nx,
@@ -574,7 +607,7 @@ impl<T: Real> Lattice<T> {
                 let mut idx = [0usize; LANES];
                 let mut len = 0;
                 while k < k1 && len < LANES {
-                    let c = psm.cells[k] as usize;
+                    let c = cells[k] as usize;
                     if !solid[c] && special_of[c] != u32::MAX {
                         let s = special_of[c];
                         sps[len] = if s != u32::MAX {
@@ -603,7 +636,7 @@ impl<T: Real> Lattice<T> {
                     continue;
                 }
                 let mut g = [[T::zero(); LANES]; Q];
-                let (mut b, mut us) = ([T::zero(); LANES], [[T::zero(); LANES]; 2]);
+                let mut lanes = [0usize; LANES];
                 for l in 0..LANES {
                     // Lanes past `len` repeat lane 0 (computed, never written back).
                     let (sp, kk) = if l < len {
@@ -616,13 +649,11 @@ impl<T: Real> Lattice<T> {
                     for i in 0..Q {
                         g[i][l] = gl[i];
                     }
-                    b[l] = psm.b[kk];
-                    us[0][l] = psm.ux[kk];
-                    us[1][l] = psm.uy[kk];
+                    lanes[l] = kk;
                 }
                 let mut post = g;
                 collider.collide(&mut post);
-                let dp = partial::blend(&g, &mut post, &b, &us, collider.force);
+                let dp = psm.apply(&lanes, &g, &mut post, collider.force);
                 for l in 0..len {
                     let out: [T; Q] = std::array::from_fn(|i| post[i][l]);
                     // SAFETY: as in `step`; entry idx[l] of `exchange` belongs to this row.
@@ -826,13 +857,13 @@ unsafe fn bulk_run<T: Real, const L: usize>(
 }
 
 /// Collide a stretch `x0..x1` of covered bulk nodes of row `y` (the cells of `psm` from entry
-/// `k0` on) as in [`bulk_run`], with the partially saturated blend of [`partial::blend`], and
+/// `k0` on) as in [`bulk_run`], with the covered-cell term [`CoveredCells::apply`], and
 /// store the exchanged momentum at `exchange[k0..]`.
 ///
 /// # Safety
 /// As [`bulk_run`]; entries `k0..k0 + x1 − x0` of `exchange` belong to this call.
 #[allow(clippy::too_many_arguments)]
-unsafe fn bulk_run_psm<T: Real, const L: usize>(
+unsafe fn bulk_run_psm<T: Real, C: CoveredCells<T>, const L: usize>(
     f: *mut T,
     n: usize,
     nx: usize,
@@ -842,7 +873,7 @@ unsafe fn bulk_run_psm<T: Real, const L: usize>(
     x1: usize,
     even: bool,
     collider: &Collider<T>,
-    psm: &PartialCells<T>,
+    psm: &C,
     k0: usize,
     exchange: *mut [f64; 2],
 ) {
@@ -868,20 +899,14 @@ unsafe fn bulk_run_psm<T: Real, const L: usize>(
             }
         }
         let g = buf;
-        // Padding lanes get B = 0 (never written back).
-        let mut b = [T::zero(); L];
-        let mut us = [[T::zero(); L]; 2];
-        for l in 0..len {
-            b[l] = psm.b[o + l];
-            us[0][l] = psm.ux[o + l];
-            us[1][l] = psm.uy[o + l];
-        }
-        // Fully covered nodes (B = 1) take f* = g + Ω^s: their fluid collision has weight
-        // 1 − B = 0, so a chunk of them skips it (the blend's 0·C(g) is then 0·g, the same).
-        if b[..len].iter().any(|&v| v != T::c(1.0)) {
+        // Padding lanes repeat entry `o` (computed, never written back).
+        let lanes: [usize; L] = std::array::from_fn(|l| if l < len { o + l } else { o });
+        // A chunk of cells whose fluid collision has weight 0 skips it (the term's 0·C(g) is
+        // then 0·g, the same).
+        if (0..len).any(|l| !psm.replaces_collision(o + l)) {
             collider.collide(&mut buf);
         }
-        let dp = partial::blend(&g, &mut buf, &b, &us, collider.force);
+        let dp = psm.apply(&lanes, &g, &mut buf, collider.force);
         for i in 0..Q {
             let slot = if even { OPP[i] } else { i };
             std::ptr::copy_nonoverlapping(buf[i].as_ptr(), f.add(offs[slot] + x), len);

@@ -1,16 +1,65 @@
-//! The fluid solver: a lattice, its collision operator and obstacles, advanced in time; and
-//! the precision-erased [`Fluid`] interface the CLI and the coupling drivers use.
+//! The fluid solver: a lattice, its collision operator and obstacles, advanced in time, built
+//! from an [`LbmSetup`]; and the precision-erased [`Fluid`] interface the runners use.
+//!
+//! τ comes from the [`Units`] (τ = 3νΔt/Δx² + ½): the collision operator is built from them,
+//! so the relaxation time and the time step cannot disagree.
 
-use super::collision::Collider;
+use super::boundary::Edges;
+use super::collision::{Collider, CollisionModel};
+use super::covered::CoveredCells;
 use super::d2q9::{CX, CY, Q};
-use super::ladd::BounceLinks;
 use super::lattice::Lattice;
-use super::obstacle::Obstacles;
-use super::partial::{self, CellForces, PartialCells, SolidCover};
+use super::obstacle::{Obstacle, Obstacles};
 use super::real::Real;
-use crate::scale::Scale;
 use crate::units::{Units, CS2};
 use crate::{Error, Result};
+
+/// Lattice Mach number |u|/c_s above which a run is stopped as unstable.
+pub const STOP_MACH: f64 = 0.5;
+
+/// The fluid's physics apart from its lattice: collision operator, LES and body force.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FluidModel {
+    /// BGK or MRT (whose rates must be those of the units' τ).
+    pub collision: CollisionModel,
+    /// Smagorinsky constant C_s; `None`: no LES.
+    pub smagorinsky: Option<f64>,
+    /// Uniform body force density (lattice units, ρ* = 1), applied by Guo forcing.
+    pub body_force: [f64; 2],
+}
+
+/// Everything a fluid is built from ([`LbmSetup::build`]): a scenario of any kind describes
+/// its fluid with one of these.
+#[derive(Clone, Debug)]
+pub struct LbmSetup {
+    /// Cells along x and y.
+    pub cells: [usize; 2],
+    /// Δx, Δt, ρ₀ and τ.
+    pub units: Units,
+    /// Collision, LES, body force.
+    pub model: FluidModel,
+    /// The four edges (velocities and densities in lattice units).
+    pub edges: Edges,
+    /// Obstacles in lattice coordinates.
+    pub obstacles: Vec<Obstacle>,
+    /// Initial velocity everywhere (lattice units), at unit density.
+    pub initial_velocity: [f64; 2],
+}
+
+impl LbmSetup {
+    /// Build the fluid in precision `T`: lattice with the obstacles' solid mask, initialised
+    /// to the equilibrium at ρ* = 1 and the initial velocity. Fails with the reason when the
+    /// edges are inconsistent.
+    pub fn build<T: Real>(&self) -> std::result::Result<Lbm<T>, String> {
+        let [nx, ny] = self.cells;
+        let obstacles = Obstacles::new(self.obstacles.clone());
+        let solid = obstacles.mask(nx, ny);
+        let mut lattice = Lattice::<T>::new(nx, ny, self.edges.clone(), solid)?;
+        let u0 = self.initial_velocity;
+        lattice.fill(|_, _| (1.0, u0[0], u0[1]));
+        Ok(Lbm::new(lattice, self.model, obstacles, self.units))
+    }
+}
 
 /// Macroscopic fields in lattice units, one value per cell (`y·nx + x`). Solid cells hold
 /// ρ = 1, u = 0.
@@ -73,24 +122,23 @@ pub struct Lbm<T> {
     pub units: Units,
     /// Steps taken.
     pub steps: u64,
-    /// Cells partially covered by moving solids (empty: a plain fluid).
-    pub partial: PartialCells<T>,
-    /// Momentum exchanged per covered cell summed over the steps of the last
-    /// [`Scale::advance`], and their number (the sum is kept only for more than one step;
-    /// for one, [`PartialCells::exchange`] is that step's).
-    exchange_sum: (Vec<[f64; 2]>, u64),
-    /// Boundary links of moving solids under Ladd's bounce-back (empty: none).
-    pub ladd: BounceLinks,
 }
 
 impl<T: Real> Lbm<T> {
-    /// Assemble a solver; links the obstacles to the lattice.
+    /// Assemble a solver from a lattice, the fluid's physics, its obstacles and its units (the
+    /// collision relaxes at the units' τ); links the obstacles to the lattice.
     pub fn new(
         mut lattice: Lattice<T>,
-        collider: Collider<T>,
+        model: FluidModel,
         mut obstacles: Obstacles,
         units: Units,
     ) -> Self {
+        let collider = Collider::new(
+            model.collision,
+            units.tau,
+            model.smagorinsky,
+            model.body_force,
+        );
         obstacles.link(&lattice);
         lattice.set_body_force(collider.force);
         Lbm {
@@ -99,23 +147,30 @@ impl<T: Real> Lbm<T> {
             obstacles,
             units,
             steps: 0,
-            partial: PartialCells::new(),
-            exchange_sum: (Vec::new(), 0),
-            ladd: BounceLinks::default(),
         }
     }
 
-    /// One lattice step; cells in [`Lbm::partial`] collide as partially saturated cells.
+    /// One lattice step.
     pub fn step(&mut self) {
         let was_even = self.lattice.next_is_even();
-        if self.partial.is_empty() {
-            self.lattice.step(&self.collider);
-        } else {
-            self.lattice.step_partial(&self.collider, &mut self.partial);
-        }
-        if !self.ladd.is_empty() {
-            self.ladd.bounce(&mut self.lattice, was_even);
-        }
+        self.lattice.step(&self.collider);
+        self.obstacles.after_step(&mut self.lattice, was_even);
+        self.steps += 1;
+    }
+
+    /// One lattice step in which the cells of `covered` collide with a coupling method's term
+    /// ([`Lattice::step_covered`], the exchanged momentum into `exchange`), and `after_stream`
+    /// (e.g. a bounce-back on moving solids) runs on the streamed lattice, with the parity of
+    /// the step just taken, before the obstacles take theirs.
+    pub fn step_covered<C: CoveredCells<T>>(
+        &mut self,
+        covered: &C,
+        exchange: &mut [[f64; 2]],
+        after_stream: impl FnOnce(&mut Lattice<T>, bool),
+    ) {
+        let was_even = self.lattice.next_is_even();
+        self.lattice.step_covered(&self.collider, covered, exchange);
+        after_stream(&mut self.lattice, was_even);
         self.obstacles.after_step(&mut self.lattice, was_even);
         self.steps += 1;
     }
@@ -134,47 +189,15 @@ impl<T: Real> Lbm<T> {
         (r, (jx + 0.5 * fx) / r, (jy + 0.5 * fy) / r)
     }
 
-    /// Set the covered cells from a solid cover in SI: B = B(ε, τ) of
-    /// [`partial::weighting`] with the molecular τ, velocities converted to lattice units.
-    /// Cells must be ascending.
-    pub fn set_cover(&mut self, cover: &SolidCover) {
-        use rayon::prelude::*;
-        let p = &mut self.partial;
-        let (tau, units, n) = (self.collider.tau, &self.units, cover.cells.len());
-        p.cells.clear();
-        p.cells.extend_from_slice(&cover.cells);
-        // Resized (a cover changes little between steps), then overwritten in one pass.
-        p.b.resize(n, T::zero());
-        p.ux.resize(n, T::zero());
-        p.uy.resize(n, T::zero());
-        p.exchange.resize(n, [0.0; 2]);
-        (
-            &mut p.b,
-            &mut p.ux,
-            &mut p.uy,
-            &mut p.exchange,
-            &cover.eps,
-            &cover.ux,
-            &cover.uy,
-        )
-            .into_par_iter()
-            .for_each(|(b, ux, uy, ex, &e, &vx, &vy)| {
-                *b = T::c(partial::weighting(e, tau));
-                *ux = T::c(units.velocity_to_lattice(vx));
-                *uy = T::c(units.velocity_to_lattice(vy));
-                *ex = [0.0; 2];
-            });
-    }
-
     /// Total fluid momentum Σ_cells Σ_i f_i e_i (lattice units, pre-collision, without the
-    /// half-force shift), accumulated in f64. Nodes inside solids under Ladd's bounce-back
-    /// ([`Lbm::ladd`]) are not fluid and not counted.
-    pub fn momentum(&self) -> [f64; 2] {
+    /// half-force shift), accumulated in f64, over the cells that are not solid and not
+    /// `excluded` (e.g. nodes inside moving solids under Ladd's bounce-back).
+    pub fn momentum(&self, excluded: impl Fn(usize) -> bool + Sync) -> [f64; 2] {
         use rayon::prelude::*;
         let lat = &self.lattice;
         (0..lat.len())
             .into_par_iter()
-            .filter(|&c| !lat.is_solid(c) && !self.ladd.is_inside(c))
+            .filter(|&c| !lat.is_solid(c) && !excluded(c))
             .map(|c| {
                 let f = lat.populations(c);
                 let mut j = [0.0; 2];
@@ -303,98 +326,5 @@ impl<T: Real> Fluid for Lbm<T> {
     }
     fn precision(&self) -> &'static str {
         T::NAME
-    }
-}
-
-/// A full copy of a fluid state.
-#[derive(Clone)]
-pub struct LbmSnapshot<T> {
-    populations: Vec<T>,
-    next_even: bool,
-    steps: u64,
-    force: Vec<[f64; 2]>,
-    torque: Vec<f64>,
-}
-
-impl<T: Real> Scale for Lbm<T> {
-    /// The cells moving solids cover (an empty cover: a plain fluid).
-    type Input = SolidCover;
-    /// Force on the solid in each covered cell, averaged over the last advance.
-    type Output = CellForces;
-    type Snapshot = LbmSnapshot<T>;
-
-    fn time(&self) -> f64 {
-        self.steps as f64 * self.units.dt
-    }
-    fn max_dt(&self) -> f64 {
-        self.units.dt
-    }
-    /// Advance by `dt`, which must be a whole number of lattice steps (within 1e-9).
-    fn advance(&mut self, input: &SolidCover, dt: f64) -> Result<()> {
-        let n = dt / self.units.dt;
-        let k = n.round();
-        if (n - k).abs() > 1e-9 * n.max(1.0) || k < 1.0 {
-            return Err(Error::Other(format!(
-                "LBM advance: dt = {dt:e} s is not a whole number of lattice steps ({:e} s)",
-                self.units.dt
-            )));
-        }
-        self.set_cover(input);
-        if !(input.links.is_empty() && self.ladd.is_empty()) {
-            self.ladd.set(&mut self.lattice, &input.links, &self.units);
-        }
-        let steps = k as u64;
-        let (sum, count) = &mut self.exchange_sum;
-        sum.clear();
-        if steps > 1 {
-            sum.resize(input.cells.len(), [0.0; 2]);
-        }
-        *count = steps;
-        for _ in 0..steps {
-            self.step();
-            if steps > 1 {
-                use rayon::prelude::*;
-                self.exchange_sum
-                    .0
-                    .par_iter_mut()
-                    .zip(self.partial.exchange.par_iter())
-                    .for_each(|(s, e)| {
-                        s[0] += e[0];
-                        s[1] += e[1];
-                    });
-            }
-        }
-        Ok(())
-    }
-    /// Force on the solid per covered cell, F = −Δp (N/m), seed eq. 5.53.
-    fn observe(&self, out: &mut CellForces) {
-        // One step: its own exchange; several: their sum.
-        let (sum, count) = match self.exchange_sum {
-            (_, 0 | 1) => (&self.partial.exchange, 1),
-            (ref sum, k) => (sum, k),
-        };
-        let k = count as f64;
-        use rayon::prelude::*;
-        let u = &self.units;
-        sum.par_iter()
-            .map(|s| (-u.force_to_si(s[0] / k), -u.force_to_si(s[1] / k)))
-            .unzip_into_vecs(&mut out.fx, &mut out.fy);
-        self.ladd.observe(&self.units, &mut out.links);
-    }
-    fn snapshot(&self) -> LbmSnapshot<T> {
-        let (populations, next_even) = self.lattice.state();
-        LbmSnapshot {
-            populations,
-            next_even,
-            steps: self.steps,
-            force: self.obstacles.force.clone(),
-            torque: self.obstacles.torque.clone(),
-        }
-    }
-    fn restore(&mut self, s: LbmSnapshot<T>) {
-        self.lattice.set_state(s.populations, s.next_even);
-        self.steps = s.steps;
-        self.obstacles.force = s.force;
-        self.obstacles.torque = s.torque;
     }
 }

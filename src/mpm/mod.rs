@@ -8,23 +8,15 @@
 //! * [`material`]: the material contract `update_stress(σ, Δε, Δω, state) → σ` (Jaumann
 //!   rate) and its laws: linear elastic, Mohr–Coulomb (non-associated, tension cut-off);
 //! * [`solver`]: the explicit step (USF / USL / MUSL), CFL step, energy bookkeeping;
-//! * [`scale`]: the [`crate::scale::Scale`] implementation;
-//! * [`scenario`]: the column-collapse scenario (TOML) and its checks;
-//! * [`run`]: the column-collapse runner (VTK series, time series, summary like the DEM's);
-//! * [`validation`]: validation cases (self-weight, biaxial, cell crossing, conservation);
-//! * [`bench`]: the `granflow bench mpm` throughput run.
+//! * [`scale`]: the [`crate::scale::Scale`] implementation.
 
-pub mod bench;
 pub mod boundary;
 pub mod grid;
 pub mod material;
 pub mod points;
-pub mod run;
 pub mod scale;
-pub mod scenario;
 pub mod shape;
 pub mod solver;
-pub mod validation;
 
 pub use boundary::{Side, Wall, WallKind};
 pub use grid::Grid;

@@ -16,7 +16,7 @@ use super::table::{Fits, REFERENCE_LAWS};
 use super::{CaseResult, Solver};
 use crate::analysis::runout::CollapseOutcome;
 use crate::io::{write_png, write_svg, CsvTable};
-use crate::validate::{Plot, Series};
+use crate::report::{Plot, Series};
 use crate::Result;
 
 /// `n` points log-spaced over [lo, hi].

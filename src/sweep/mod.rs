@@ -23,6 +23,7 @@ use rayon::prelude::*;
 
 use crate::analysis::runout::CollapseOutcome;
 use crate::io::write_atomic;
+use crate::scenario::ScenarioFile;
 use crate::{Error, Result};
 pub use spec::{read_sweep, Case, Solver, SweepSpec};
 
@@ -72,7 +73,7 @@ fn reusable(case: &Case, dir: &Path) -> Option<CollapseOutcome> {
 }
 
 /// Runs one case in `dir` (see the module doc for reuse).
-fn run_case(case: &Case, dir: &Path, progress: crate::run::Progress) -> Result<CollapseOutcome> {
+fn run_case(case: &Case, dir: &Path, progress: crate::exec::Progress) -> Result<CollapseOutcome> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     // A stale summary must not survive a run that fails part-way.
     let summary = dir.join("summary.json");
@@ -84,12 +85,12 @@ fn run_case(case: &Case, dir: &Path, progress: crate::run::Progress) -> Result<C
     })?;
     Ok(match case.solver {
         Solver::Dem => {
-            let s = crate::dem::scenario::DemScenario::from_toml(&case.scenario)?;
-            crate::dem::run::run_column_collapse(&s, dir, progress)?.collapse
+            let s = crate::scenario::dem::DemScenario::from_toml(&case.scenario)?;
+            crate::scenario::collapse::dem::run_column_collapse(&s, dir, progress)?.collapse
         }
         Solver::Mpm => {
-            let s = crate::mpm::scenario::MpmScenario::from_toml(&case.scenario)?;
-            crate::mpm::run::run_column_collapse(&s, dir, progress)?.collapse
+            let s = crate::scenario::mpm::MpmScenario::from_toml(&case.scenario)?;
+            crate::scenario::collapse::mpm::run_column_collapse(&s, dir, progress)?.collapse
         }
     })
 }
@@ -110,10 +111,10 @@ pub fn run_sweep(path: &Path, out: &Path, jobs: usize) -> Result<SweepReport> {
     // Every case must parse before anything runs: a bad value fails the sweep up front.
     for case in &cases {
         match case.solver {
-            Solver::Dem => crate::dem::scenario::DemScenario::from_toml(&case.scenario)?
+            Solver::Dem => crate::scenario::dem::DemScenario::from_toml(&case.scenario)?
                 .derive()
                 .map(|_| ()),
-            Solver::Mpm => crate::mpm::scenario::MpmScenario::from_toml(&case.scenario)?
+            Solver::Mpm => crate::scenario::mpm::MpmScenario::from_toml(&case.scenario)?
                 .derive()
                 .map(|_| ()),
         }

@@ -2,6 +2,7 @@
 //! vary, expanded into one fully resolved scenario per case.
 //!
 //! ```toml
+//! kind = "sweep"
 //! name = "sweep_quick"
 //! description = "…"
 //!
@@ -32,6 +33,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use toml::Value;
 
+use crate::scenario::{Kind, ScenarioFile};
 use crate::{Error, Result};
 
 /// The solvers a sweep can run.
@@ -58,6 +60,8 @@ impl Solver {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SweepSpec {
+    /// `"sweep"`: what the file describes.
+    pub kind: Kind,
     /// Sweep name.
     pub name: String,
     /// One line on what it is for.
@@ -84,9 +88,13 @@ pub struct Case {
     pub labels: Vec<(String, Value)>,
 }
 
+impl ScenarioFile for SweepSpec {
+    const KIND: Kind = Kind::Sweep;
+}
+
 /// Reads and expands a sweep file into its cases (in solver, then dimension order).
 pub fn read_sweep(path: &Path) -> Result<(SweepSpec, Vec<Case>)> {
-    let spec: SweepSpec = crate::config::read_toml(path)?;
+    let spec = SweepSpec::from_file(path)?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let cases = expand(&spec, dir)?;
     Ok((spec, cases))
@@ -278,6 +286,7 @@ mod tests {
         );
         let s = spec(
             r#"
+            kind = "sweep"
             name = "s"
             description = "x"
             [solvers]
@@ -324,7 +333,8 @@ mod tests {
             "d.toml",
             "name = \"d\"\n[column]\naspect_ratio = 2\n",
         );
-        let base = "name = \"s\"\ndescription = \"x\"\n[solvers]\ndem = \"d.toml\"\n";
+        let base =
+            "kind = \"sweep\"\nname = \"s\"\ndescription = \"x\"\n[solvers]\ndem = \"d.toml\"\n";
         let msg = |extra: &str| {
             expand(&spec(&format!("{base}{extra}")), dir.path())
                 .unwrap_err()

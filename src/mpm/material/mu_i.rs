@@ -13,7 +13,7 @@
 //! DEM's shear cell is a granular gas (normal-stress ratio σ_xx/σ_yy 2–6, coordination < 0.2)
 //! whose friction stops rising, so the fit is not carried past it. sin φ is
 //! the 2-D Mohr–Coulomb friction (σ₁ − σ₃)/(σ₁ + σ₃), the quantity the DEM's periodic shear
-//! cell measures (`granflow shear`, [`crate::dem::mu_i`]), so its fitted law can be used as
+//! cell measures (`granflow shear`, [`crate::scenario::dem::shear`]), so its fitted law can be used as
 //! it is. At I → 0 this is the rate-independent Mohr–Coulomb of angle φ_s; the dilatancy
 //! angle, cohesion and tension cut-off are as there.
 

@@ -1,0 +1,112 @@
+//! `granflow bench`: throughput of each solver, machine-readable with `--json`.
+
+use std::process::ExitCode;
+
+use anyhow::Result;
+
+use crate::{Bench, Collision, Precision};
+
+pub fn bench(which: Bench) -> Result<ExitCode> {
+    match which {
+        Bench::Mpm {
+            points,
+            steps,
+            threads,
+            repeats,
+            shape,
+            json,
+        } => {
+            let shape = match shape.as_str() {
+                "gimp" => granflow::mpm::ShapeKind::Gimp,
+                "standard" => granflow::mpm::ShapeKind::Standard,
+                other => anyhow::bail!("--shape must be gimp or standard, got {other}"),
+            };
+            let r = granflow::scenario::mpm::bench::mpm(points, steps, threads, repeats, shape)?;
+            if json {
+                println!("{}", serde_json::to_string(&r)?);
+            } else {
+                println!(
+                    "mpm {} points ({}×{} cells), {} on {} threads: {:.3e} point-steps/s (samples {:?})",
+                    r.points, r.cells[0], r.cells[1], r.shape, r.threads, r.point_steps_per_s, r.samples
+                );
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Bench::Lbm {
+            nx,
+            ny,
+            steps,
+            precision,
+            collision,
+            threads,
+            repeats,
+            json,
+        } => {
+            let r = granflow::scenario::fluid::bench::lbm(
+                nx,
+                ny,
+                steps,
+                matches!(precision, Precision::F64),
+                matches!(collision, Collision::Mrt),
+                threads,
+                repeats,
+            )?;
+            if json {
+                println!("{}", serde_json::to_string(&r)?);
+            } else {
+                println!(
+                    "lbm {}×{} {} {} on {} threads: {:.1} MLUPS (samples {:?}); copy {:.1} GB/s; {} B/cell; {:.0} % of roofline",
+                    r.nx, r.ny, r.precision, r.collision, r.threads, r.mlups, r.samples.iter().map(|s| (s * 10.0).round() / 10.0).collect::<Vec<_>>(), r.copy_gb_s, r.bytes_per_cell, 100.0 * r.roofline_fraction
+                );
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Bench::Dem {
+            grains,
+            steps,
+            threads,
+            repeats,
+            json,
+        } => {
+            let r = granflow::scenario::dem::bench::run(grains, steps, threads, repeats)?;
+            if json {
+                println!("{}", serde_json::to_string(&r)?);
+            } else {
+                println!(
+                    "dem {} grains, {} steps on {} threads: {:.3e} particle-steps/s (samples {:?}); {:.0} contacts/step; {:.3} list builds/step",
+                    r.grains, r.steps, r.threads, r.particle_steps_per_s,
+                    r.samples.iter().map(|s| format!("{s:.3e}")).collect::<Vec<_>>(),
+                    r.contacts_per_step, r.list_builds_per_step
+                );
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Bench::Coupled {
+            nx,
+            ny,
+            grains,
+            steps,
+            precision,
+            threads,
+            json,
+        } => {
+            let r = granflow::scenario::submerged::bench::coupled(
+                nx,
+                ny,
+                grains,
+                steps,
+                matches!(precision, Precision::F64),
+                threads,
+            )?;
+            if json {
+                println!("{}", serde_json::to_string(&r)?);
+            } else {
+                println!(
+                    "coupled {}×{} {} with {} grains on {} threads: {:.1} MLUPS, {:.3e} grain steps/s, {:.2} s for {} steps ({} covered cells, {} DEM sub-steps per fluid step)",
+                    r.nx, r.ny, r.precision, r.grains, r.threads, r.mlups, r.particle_steps_per_s, r.seconds, r.steps, r.covered_cells, r.subcycles
+                );
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}

@@ -1,0 +1,44 @@
+//! The commands behind the `granflow` subcommands.
+//!
+//! * [`run`]: `check` and `run` of a scenario file of any kind (dispatched on its `kind`);
+//! * [`study`]: `validate`, `sweep`, `biaxial`, `shear`;
+//! * [`bench`]: `bench`.
+
+pub mod bench;
+pub mod run;
+pub mod study;
+
+use std::io::IsTerminal;
+use std::path::Path;
+
+/// Run `f` with a progress callback: an indicatif bar on a terminal, a plain line every 10 %
+/// otherwise (logs, CI).
+fn with_progress<R>(total: u64, unit: &str, f: impl FnOnce(&mut dyn FnMut(u64, u64)) -> R) -> R {
+    if std::io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(total);
+        let template =
+            format!("{{elapsed_precise}} [{{bar:40}}] {{pos}}/{{len}} {unit}, eta {{eta}}");
+        bar.set_style(indicatif::ProgressStyle::with_template(&template).expect("valid template"));
+        let r = f(&mut |i, _| bar.set_position(i));
+        bar.finish();
+        r
+    } else {
+        let mut last = 0;
+        f(&mut |i, n| {
+            let pct = i * 10 / n.max(1);
+            if pct > last {
+                last = pct;
+                eprintln!("{i}/{n} {unit} ({}%)", pct * 10);
+            }
+        })
+    }
+}
+
+/// Context for a run that failed part-way.
+fn stopped(path: &Path, out: &Path) -> String {
+    format!(
+        "run of {} stopped; frames written so far are in {}",
+        path.display(),
+        out.display()
+    )
+}

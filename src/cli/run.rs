@@ -1,0 +1,275 @@
+//! `granflow check` and `granflow run`: a scenario file of any kind, dispatched on its `kind`.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+
+use granflow::scenario::dem::DemScenario;
+use granflow::scenario::fluid::Scenario;
+use granflow::scenario::mpm::MpmScenario;
+use granflow::scenario::submerged::SubmergedScenario;
+use granflow::scenario::{kind_of_file, Kind, ScenarioFile};
+
+use super::{stopped, with_progress};
+
+/// `granflow check`: parse, derive and print, refuse bad input; no run.
+pub fn check(path: &Path) -> Result<ExitCode> {
+    match kind_of_file(path)? {
+        Kind::Fluid => check_fluid(path),
+        Kind::Dem => check_dem(path),
+        Kind::Mpm => check_mpm(path),
+        Kind::Submerged => {
+            let s = SubmergedScenario::from_file(path)?;
+            print!("{}", s.check_report()?);
+            Ok(ExitCode::SUCCESS)
+        }
+        Kind::Sweep => check_sweep(path),
+    }
+}
+
+/// A sweep file: its cases, resolved and checked.
+fn check_sweep(path: &Path) -> Result<ExitCode> {
+    let (spec, cases) = granflow::sweep::read_sweep(path)?;
+    println!("sweep           {} — {}", spec.name, spec.description);
+    for c in &cases {
+        println!("case            {}", c.name);
+    }
+    println!("ok ({} cases; run with `granflow sweep`)", cases.len());
+    Ok(ExitCode::SUCCESS)
+}
+
+fn check_fluid(path: &Path) -> Result<ExitCode> {
+    let s = Scenario::from_file(path)?;
+    let d = s.derive()?;
+    let u = &d.units;
+    println!("scenario        {} — {}", s.name, s.description);
+    println!(
+        "cells           {} × {} = {}",
+        d.cells[0],
+        d.cells[1],
+        d.cells[0] * d.cells[1]
+    );
+    println!("dx              {:.6e} m", u.dx);
+    println!("dt              {:.6e} s", u.dt);
+    println!("tau             {:.6}", u.tau);
+    println!("nu (lattice)    {:.6e}", d.nu_lattice);
+    println!("u_ref (lattice) {:.6e}", d.u_lattice);
+    println!(
+        "Mach (lattice)  {:.4}  (limit {})",
+        d.mach,
+        granflow::scenario::fluid::MAX_MACH
+    );
+    println!("Reynolds        {:.4}", d.reynolds);
+    println!("steps           {} ({} s)", d.steps, s.time.end);
+    println!(
+        "frames          every {} steps ({} frames)",
+        d.frame_every,
+        d.steps.div_ceil(d.frame_every) + 1
+    );
+    println!("series          every {} steps", d.series_every);
+    println!(
+        "force (lattice) [{:.4e}, {:.4e}]",
+        d.force_lattice[0], d.force_lattice[1]
+    );
+    println!(
+        "collision       {:?}{}",
+        s.lbm.collision,
+        s.lbm
+            .smagorinsky
+            .map_or(String::new(), |c| format!(" + Smagorinsky C = {c}"))
+    );
+    if let Some(r) = d.mrt {
+        println!(
+            "MRT rates       s_e = {:.4}, s_eps = {:.4}, s_q = {:.4}, s_nu = {:.4}",
+            r.s_e,
+            r.s_eps,
+            r.s_q,
+            1.0 / u.tau
+        );
+    }
+    println!("precision       {:?}", s.lbm.precision);
+    println!(
+        "memory          {:.1} MiB (populations)",
+        d.memory_bytes as f64 / (1 << 20) as f64
+    );
+    println!("obstacles       {}", s.obstacles.len());
+    println!("ok");
+    Ok(ExitCode::SUCCESS)
+}
+
+fn check_dem(path: &Path) -> Result<ExitCode> {
+    let s = DemScenario::from_file(path)?;
+    let d = s.derive()?;
+    println!(
+        "scenario        {} — {} (DEM column collapse)",
+        s.name, s.description
+    );
+    println!("grains          {}", d.grains);
+    println!(
+        "column          L_i = {:.4e} m, target H_i = {:.4e} m",
+        s.column.width, d.target_height
+    );
+    println!("tau_c (target)  {:.4e} s", d.target_tau_c);
+    match d.params.dt {
+        Some(dt) => println!("dt              {dt:.4e} s (given)"),
+        None => println!(
+            "dt              λ·Δt_cr with λ = {} (computed from the smallest grain)",
+            d.params.lambda
+        ),
+    }
+    println!("ok");
+    Ok(ExitCode::SUCCESS)
+}
+
+fn check_mpm(path: &Path) -> Result<ExitCode> {
+    let s = MpmScenario::from_file(path)?;
+    let d = s.derive()?;
+    println!(
+        "scenario        {} — {} (MPM column collapse)",
+        s.name, s.description
+    );
+    println!(
+        "column          L_i = {:.4e} m, H_i = {:.4e} m, τ_c = {:.4e} s",
+        s.column.width, d.height, d.tau_c
+    );
+    println!(
+        "grid            {} × {} cells of {:.4e} m, {} points",
+        d.cells[0], d.cells[1], s.mpm.cell_size, d.points
+    );
+    println!(
+        "wave speed      c = √((K + 4G/3)/ρ) = {:.4} m/s",
+        d.wave_speed
+    );
+    println!(
+        "dt (CFL)        {:.4e} s (Courant {})",
+        d.dt_cfl, s.mpm.courant
+    );
+    if let Some(dt) = s.time.dt {
+        println!("dt              {dt:.4e} s (given)");
+    }
+    println!("ok");
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_mpm(path: &Path, out: &Path) -> Result<ExitCode> {
+    let s = MpmScenario::from_file(path)?;
+    let d = s.derive()?;
+    eprintln!(
+        "{}: MPM column collapse, {} points -> {}",
+        s.name,
+        d.points,
+        out.display()
+    );
+    let end = (1e3 * s.time.end_tc) as u64;
+    let r = with_progress(end, "milli-τ_c", |p| {
+        granflow::scenario::collapse::mpm::run_column_collapse(&s, out, p)
+    })
+    .with_context(|| stopped(path, out))?;
+    println!(
+        "done: a = {:.3}, L_f = {:.4} m, (L_f − L_i)/L_i = {:.3}, H_f/L_i = {:.3}, spreading stopped at {:.2} τ_c, {} at {:.2} τ_c, {} points, {:.1} s wall",
+        r.collapse.aspect_ratio,
+        r.collapse.l_f,
+        r.collapse.delta_l,
+        r.collapse.h_f_over_l_i,
+        r.collapse.stop_time_tc,
+        if r.collapse.at_rest { "at rest" } else { "end time reached" },
+        r.collapse.rest_time_tc,
+        r.points,
+        r.collapse.wall_time_s
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_dem(path: &Path, out: &Path) -> Result<ExitCode> {
+    let s = DemScenario::from_file(path)?;
+    let d = s.derive()?;
+    eprintln!(
+        "{}: DEM column collapse, {} grains -> {}",
+        s.name,
+        d.grains,
+        out.display()
+    );
+    let end = (1e3 * s.time.end_tc) as u64;
+    let r = with_progress(end, "milli-τ_c", |p| {
+        granflow::scenario::collapse::dem::run_column_collapse(&s, out, p)
+    })
+    .with_context(|| stopped(path, out))?;
+    println!(
+        "done: a = {:.3}, L_f/L_i − 1 = {:.3}, H_f/L_i = {:.3}, spreading stopped at {:.2} τ_c, {} at {:.2} τ_c, {} grains, packing {:.3}",
+        r.collapse.aspect_ratio,
+        r.collapse.delta_l,
+        r.collapse.h_f_over_l_i,
+        r.collapse.stop_time_tc,
+        if r.collapse.at_rest { "at rest" } else { "end time reached" },
+        r.collapse.rest_time_tc,
+        r.grains,
+        r.packing_fraction
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `granflow run`: run a scenario and write its outputs.
+pub fn run(path: &Path, out: &Path) -> Result<ExitCode> {
+    match kind_of_file(path)? {
+        Kind::Fluid => run_fluid(path, out),
+        Kind::Dem => run_dem(path, out),
+        Kind::Mpm => run_mpm(path, out),
+        Kind::Submerged => run_submerged(path, out),
+        Kind::Sweep => anyhow::bail!(
+            "{} is a sweep file: run it with `granflow sweep {} --out DIR`",
+            path.display(),
+            path.display()
+        ),
+    }
+}
+
+fn run_submerged(path: &Path, out: &Path) -> Result<ExitCode> {
+    {
+        let s = SubmergedScenario::from_file(path)?;
+        eprintln!("{}: submerged column collapse -> {}", s.name, out.display());
+        let r = with_progress((1e3 * s.time.end_tc) as u64, "milli-τ_c", |p| {
+            granflow::scenario::collapse::submerged::run_submerged(&s, out, p)
+        })
+        .with_context(|| stopped(path, out))?;
+        println!("{}", r.done_line());
+        Ok(ExitCode::SUCCESS)
+    }
+}
+
+fn run_fluid(path: &Path, out: &Path) -> Result<ExitCode> {
+    let s = Scenario::from_file(path)?;
+    let d = s.derive()?;
+    eprintln!(
+        "{}: {} × {} cells, τ = {:.4}, Mach {:.3}, Re {:.1}, {} steps -> {}",
+        s.name,
+        d.cells[0],
+        d.cells[1],
+        d.units.tau,
+        d.mach,
+        d.reynolds,
+        d.steps,
+        out.display()
+    );
+    let summary = with_progress(d.steps, "steps", |p| {
+        granflow::scenario::fluid::run::run(&s, out, p)
+    })
+    .with_context(|| stopped(path, out))?;
+    println!(
+        "done: {} steps, {:.1} s simulated, {} frames, {:.1} s wall, {:.1} MLUPS, mass drift {:.2e}",
+        summary.steps, summary.time, summary.frames, summary.wall_seconds, summary.mlups, summary.mass_drift
+    );
+    for o in &summary.obstacles {
+        println!(
+            "  {}: F = ({:.6e}, {:.6e}) N/m, coefficients ({:.4}, {:.4}){}",
+            o.name,
+            o.force[0],
+            o.force[1],
+            o.coefficients[0],
+            o.coefficients[1],
+            o.strouhal
+                .map_or(String::new(), |st| format!(", St = {st:.4}"))
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,5 @@
+//! The column-collapse runners.
+
+pub mod dem;
+pub mod mpm;
+pub mod submerged;

@@ -1,0 +1,349 @@
+//! Runner of the MPM column collapse ([`MpmScenario`]): release the column, integrate until the
+//! mass is at rest, and write (the same contract as the DEM's `dem::run`)
+//!
+//! * `series.pvd` with, per frame, `points_NNNNNN.vtu` (part 0: material points with velocity,
+//!   stress components, mean stress p = tr σ/3, deviatoric (von Mises) stress q = √(3J₂),
+//!   equivalent plastic strain, volume) and `grid_NNNNNN.vti` (part 1: per cell the mass
+//!   density and mean velocity of the points in it);
+//! * `timeseries.csv`: t, t/τ_c, run-out, front, height, energies, budget error (the DEM's
+//!   column names where they apply);
+//! * `summary.json` ([`MpmCollapseSummary`], the DEM's `CollapseSummary` keys plus MPM ones).
+//!
+//! Attachment (what the run-out measures): a grid cell is occupied when a material point's
+//! centre lies in it; occupied cells sharing an edge or a corner are connected; the *main
+//! mass* is the connected set holding the most points. So a point is attached when its cell
+//! touches the main mass's cells: points up to about one cell (≤ 2h) apart stay attached,
+//! isolated points thrown further are not. The run-out L(t) is the largest x + l_p over the
+//! main mass (the point's domain edge), measured from the back wall; the front is the largest
+//! x + l_p over all points; the height H(t) is the largest y + l_p over the main mass.
+//! The *stop time* is when spreading ends: the first time after which L(t) stays within
+//! 1 % of L_i of L_f, as for the DEM ([`crate::analysis::runout::spreading_end`]). The run ends when the kinetic energy has
+//! stayed below `rest_kinetic_fraction` × the initial potential energy above the floor for
+//! `rest_duration_tc` τ_c (and t ≥ 1 τ_c; reported as `rest_time_tc`), or at `end_tc` τ_c.
+
+use std::path::Path;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::analysis::runout::{CollapseOutcome, CollapseRecord};
+use crate::io::{write_json, write_vti, write_vtu_points, CsvWriter, Field, ImageGrid, PvdSeries};
+use crate::mpm::solver::{Mpm, MpmEnergy};
+use crate::scenario::mpm::spec::MpmScenario;
+use crate::{Error, Result};
+
+/// What an MPM collapse run reports (`summary.json`): the solver-independent outcome (the
+/// same keys as the DEM's, so the two compare directly), the DEM's other keys where they have
+/// a meaning, and MPM-specific ones.
+#[derive(Clone, Debug, Serialize)]
+pub struct MpmCollapseSummary {
+    /// L_f, ΔL, H_f, stop time, … (the keys every collapse runner writes).
+    #[serde(flatten)]
+    pub collapse: CollapseOutcome,
+    /// DEM key: here the number of material points.
+    pub grains: usize,
+    /// DEM key: not defined for the continuum (null).
+    pub packing_fraction: Option<f64>,
+    /// DEM key (deposition): 0, the MPM column is built directly.
+    pub deposition_wall_time_s: f64,
+    /// `"mpm"`.
+    pub solver: String,
+    /// Number of material points.
+    pub points: usize,
+    /// Grid cells (x, y).
+    pub cells: [usize; 2],
+    /// Cell size h (m).
+    pub cell_size: f64,
+}
+
+/// Run-out, front and height (see the module doc).
+#[derive(Clone, Copy, Debug)]
+pub struct Shape {
+    /// Largest x + l_p over the main mass.
+    pub runout: f64,
+    /// Largest x + l_p over all points.
+    pub front: f64,
+    /// Largest y + l_p over the main mass.
+    pub height: f64,
+}
+
+fn find(parent: &mut [u32], mut a: u32) -> u32 {
+    while parent[a as usize] != a {
+        let p = parent[a as usize];
+        parent[a as usize] = parent[p as usize];
+        a = p;
+    }
+    a
+}
+
+/// Measure the deposit shape (see the module doc).
+pub fn shape(mpm: &Mpm) -> Shape {
+    let g = &mpm.grid;
+    let (nx, ny) = (g.nx, g.ny);
+    let cell = |x: [f64; 2]| -> usize {
+        let i = ((x[0] - g.origin[0]) / g.h)
+            .floor()
+            .clamp(0.0, (nx - 1) as f64) as usize;
+        let j = ((x[1] - g.origin[1]) / g.h)
+            .floor()
+            .clamp(0.0, (ny - 1) as f64) as usize;
+        i * ny + j
+    };
+    let mut count = vec![0u32; nx * ny];
+    for &x in &mpm.points.pos {
+        count[cell(x)] += 1;
+    }
+    let mut parent: Vec<u32> = (0..(nx * ny) as u32).collect();
+    for i in 0..nx {
+        for j in 0..ny {
+            let c = i * ny + j;
+            if count[c] == 0 {
+                continue;
+            }
+            // Neighbours already visited: (i−1, j−1..=j+1) and (i, j−1).
+            let mut link = |d: usize| {
+                if count[d] > 0 {
+                    let (a, b) = (find(&mut parent, c as u32), find(&mut parent, d as u32));
+                    if a != b {
+                        parent[a as usize] = b;
+                    }
+                }
+            };
+            if j > 0 {
+                link(c - 1);
+            }
+            if i > 0 {
+                for dj in [-1i64, 0, 1] {
+                    let jj = j as i64 + dj;
+                    if jj >= 0 && jj < ny as i64 {
+                        link((i - 1) * ny + jj as usize);
+                    }
+                }
+            }
+        }
+    }
+    let mut size = vec![0u32; nx * ny];
+    for (c, &k) in count.iter().enumerate() {
+        if k > 0 {
+            let r = find(&mut parent, c as u32);
+            size[r as usize] += k;
+        }
+    }
+    let main = (0..nx * ny).max_by_key(|&r| size[r]).unwrap_or(0) as u32;
+    let (mut runout, mut front, mut height) = (0.0f64, 0.0f64, 0.0f64);
+    for (q, &x) in mpm.points.pos.iter().enumerate() {
+        let lp = mpm.points.half_size[q];
+        front = front.max(x[0] + lp);
+        if find(&mut parent, cell(x) as u32) == main {
+            runout = runout.max(x[0] + lp);
+            height = height.max(x[1] + lp);
+        }
+    }
+    Shape {
+        runout,
+        front,
+        height,
+    }
+}
+
+fn write_frame(mpm: &Mpm, dir: &Path, k: usize, pvd: &mut PvdSeries) -> Result<()> {
+    let p = &mpm.points;
+    let n = p.len();
+    let comp = |c: usize| -> Vec<f64> { p.stress.iter().map(|s| s[c]).collect() };
+    let (sxx, syy, sxy, szz) = (comp(0), comp(1), comp(2), comp(3));
+    let inv: Vec<(f64, f64)> = p.stress.iter().map(Mpm::invariants).collect();
+    let mean: Vec<f64> = inv.iter().map(|v| v.0).collect();
+    let dev: Vec<f64> = inv.iter().map(|v| v.1).collect();
+    let eps: Vec<f64> = p.state.iter().map(|s| s.plastic_strain).collect();
+    let name = format!("points_{k:06}.vtu");
+    write_vtu_points(
+        &dir.join(&name),
+        &p.pos,
+        &[
+            Field::vector("velocity", &p.vel),
+            Field::scalar("stress_xx", &sxx),
+            Field::scalar("stress_yy", &syy),
+            Field::scalar("stress_xy", &sxy),
+            Field::scalar("stress_zz", &szz),
+            Field::scalar("mean_stress", &mean),
+            Field::scalar("deviatoric_stress", &dev),
+            Field::scalar("plastic_strain", &eps),
+            Field::scalar("volume", &p.vol),
+        ],
+        &[],
+        &[],
+    )?;
+    let g = &mpm.grid;
+    let mut rho = vec![0.0; g.nx * g.ny];
+    let mut mv = vec![[0.0; 2]; g.nx * g.ny];
+    for q in 0..n {
+        let x = p.pos[q];
+        let i = ((x[0] - g.origin[0]) / g.h)
+            .floor()
+            .clamp(0.0, (g.nx - 1) as f64) as usize;
+        let j = ((x[1] - g.origin[1]) / g.h)
+            .floor()
+            .clamp(0.0, (g.ny - 1) as f64) as usize;
+        // VTK image cells are x-fastest.
+        let c = j * g.nx + i;
+        rho[c] += p.mass[q];
+        mv[c][0] += p.mass[q] * p.vel[q][0];
+        mv[c][1] += p.mass[q] * p.vel[q][1];
+    }
+    let vel: Vec<[f64; 2]> = rho
+        .iter()
+        .zip(&mv)
+        .map(|(&m, v)| {
+            if m > 0.0 {
+                [v[0] / m, v[1] / m]
+            } else {
+                [0.0; 2]
+            }
+        })
+        .collect();
+    rho.iter_mut().for_each(|m| *m /= g.h * g.h);
+    let gname = format!("grid_{k:06}.vti");
+    write_vti(
+        &dir.join(&gname),
+        &ImageGrid {
+            nx: g.nx,
+            ny: g.ny,
+            origin: g.origin,
+            spacing: [g.h, g.h],
+        },
+        &[
+            Field::scalar("density", &rho),
+            Field::vector("velocity", &vel),
+        ],
+    )?;
+    pvd.add(mpm.time(), 0, &name)?;
+    pvd.add(mpm.time(), 1, &gname)
+}
+
+/// Run the collapse described by `scenario`, writing into `out_dir` (created if missing).
+/// Returns the summary also written to `summary.json`.
+pub fn run_column_collapse(
+    scenario: &MpmScenario,
+    out_dir: &Path,
+    progress: crate::exec::Progress,
+) -> Result<MpmCollapseSummary> {
+    let (mut mpm, d) = scenario.build()?;
+    std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
+    let (l_i, h_i, tau_c) = (scenario.column.width, d.height, d.tau_c);
+    let e0 = mpm.energy();
+    let ts = &scenario.time;
+    let dt = mpm.dt();
+    let series_steps = ((ts.series_interval_tc * tau_c / dt).ceil() as u64).max(1);
+    let frame_every = ((ts.frame_interval_tc / ts.series_interval_tc).round() as u64).max(1);
+    let mut csv = CsvWriter::create(
+        &out_dir.join("timeseries.csv"),
+        &[
+            "t",
+            "t_over_tc",
+            "runout",
+            "front",
+            "height",
+            "kinetic",
+            "potential",
+            "elastic",
+            "dissipated_plastic",
+            "dissipated_normal",
+            "dissipated_friction",
+            "dissipated_damping",
+            "budget_error",
+        ],
+    )?;
+    let mut pvd = PvdSeries::new(out_dir);
+    let rest_limit = ts.rest_kinetic_fraction * e0.potential;
+    let (mut rest_since, mut at_rest) = (None::<f64>, false);
+    let (mut row, mut frame) = (0u64, 0usize);
+    let mut history = Vec::new();
+    let t_run = Instant::now();
+    // Relative to the booked dissipation; 0 while almost nothing is dissipated (t ≈ 0, where
+    // the ratio would be round-off over round-off).
+    let tiny = 1e-9 * e0.total().abs();
+    let budget = |e: &MpmEnergy| {
+        if e.dissipated() > tiny {
+            (e.total() - e0.total()).abs() / e.dissipated()
+        } else {
+            0.0
+        }
+    };
+    let mut last;
+    loop {
+        let e = mpm.energy();
+        let s = shape(&mpm);
+        let t = mpm.time();
+        history.push((t, s.runout));
+        csv.row(&[
+            t,
+            t / tau_c,
+            s.runout,
+            s.front,
+            s.height,
+            e.kinetic,
+            e.potential,
+            e.elastic,
+            e.plastic,
+            e.boundary_normal,
+            e.boundary_friction,
+            e.damping,
+            budget(&e),
+        ])?;
+        if row % frame_every == 0 {
+            write_frame(&mpm, out_dir, frame, &mut pvd)?;
+            frame += 1;
+        }
+        row += 1;
+        if e.kinetic < rest_limit {
+            let since = *rest_since.get_or_insert(t);
+            if t >= tau_c && t - since >= ts.rest_duration_tc * tau_c {
+                at_rest = true;
+            }
+        } else {
+            rest_since = None;
+        }
+        last = (s, e);
+        progress((1e3 * t / tau_c) as u64, (1e3 * ts.end_tc) as u64);
+        if at_rest || t >= ts.end_tc * tau_c {
+            break;
+        }
+        mpm.steps(series_steps)?;
+    }
+    let wall_time_s = t_run.elapsed().as_secs_f64();
+    if (row - 1) % frame_every != 0 {
+        write_frame(&mpm, out_dir, frame, &mut pvd)?;
+    }
+    let (s, e) = last;
+    let steps = mpm.step_count();
+    let n = mpm.points.len();
+    let collapse = CollapseOutcome::from(CollapseRecord {
+        name: &scenario.name,
+        l_i,
+        h_i,
+        gravity: scenario.gravity,
+        history: &history,
+        h_f: s.height,
+        rest_since,
+        at_rest,
+        t_end: mpm.time(),
+        dt,
+        steps,
+        wall_time_s,
+        particles: n,
+        energy_budget_error: budget(&e),
+        energy: e.budget(&e0),
+    });
+    let summary = MpmCollapseSummary {
+        collapse,
+        grains: n,
+        packing_fraction: None,
+        deposition_wall_time_s: 0.0,
+        solver: "mpm".into(),
+        points: n,
+        cells: [mpm.grid.nx, mpm.grid.ny],
+        cell_size: mpm.grid.h,
+    };
+    write_json(&out_dir.join("summary.json"), &summary)?;
+    Ok(summary)
+}

@@ -1,0 +1,475 @@
+//! The MPM column-collapse scenario (Lajeunesse et al. 2005 as simulated with GIMPM in the seed
+//! thesis): TOML types, checks, and the set-up derived from them.
+//!
+//! Geometry as the DEM scenario (`models/column_collapse/dem_a*.toml`), so the two compare: a
+//! box with a floor at y = 0, a back wall at x = 0 and an end wall at x = `column.box_length`
+//! (placed on the first grid line at or beyond it); a column of width L_i and height
+//! H_i = a L_i against the back wall, released at t = 0 (no gate; the column starts
+//! unstressed, as in the thesis). τ_c = √(H_i/g).
+//!
+//! The column is filled with n × n points per cell (`mpm.points_per_cell`), each of volume
+//! (h/n)² and uGIMP half-width h/(2n); the grid has 2 ghost cells outside the walls and 4
+//! cells of head room above the column. L_i and H_i must be multiples of the cell size h.
+//!
+//! Every physical value must be given: there are no defaults (`deny_unknown_fields` also
+//! refuses misspelt keys). [`MpmScenario::derive`] refuses bad values with the TOML path named;
+//! [`crate::mpm::Mpm::new`] refuses a step above the CFL limit, naming `time.dt`.
+
+use serde::{Deserialize, Serialize};
+
+use crate::mpm::boundary::{Side, Wall, WallKind};
+use crate::mpm::grid::Grid;
+use crate::mpm::material::{LinearElastic, MaterialModel, MohrCoulomb, MuIMohrCoulomb};
+use crate::mpm::points::Points;
+use crate::mpm::shape::ShapeKind;
+use crate::mpm::solver::{cfl_step, Mpm, MpmParams, Scheme, Transfer};
+use crate::scenario::{non_negative, positive, Kind, ScenarioFile};
+use crate::{Error, Result};
+
+/// An MPM column-collapse scenario, as read from TOML. All values SI (angles in degrees).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MpmScenario {
+    /// `"mpm"`: what the file describes.
+    pub kind: Kind,
+    /// Short name used in outputs.
+    pub name: String,
+    /// One line saying what the case is (and how it was scaled).
+    pub description: String,
+    /// Gravitational acceleration g (m/s², acting along −y).
+    pub gravity: f64,
+    /// The continuum's constitutive law.
+    pub material: MaterialSpec,
+    /// Column and box geometry.
+    pub column: MpmColumn,
+    /// Discretisation.
+    pub mpm: MpmSpec,
+    /// Wall conditions.
+    pub walls: WallsSpec,
+    /// Time step, outputs, stop.
+    pub time: MpmTimeSpec,
+}
+
+/// Constitutive law, chosen by `model`.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
+pub enum MaterialSpec {
+    /// Linear isotropic elasticity.
+    LinearElastic {
+        /// Density ρ (kg/m³).
+        density: f64,
+        /// Young's modulus E (Pa).
+        youngs_modulus: f64,
+        /// Poisson's ratio ν.
+        poisson_ratio: f64,
+    },
+    /// Mohr–Coulomb, non-associated, with tension cut-off.
+    MohrCoulomb {
+        /// Density ρ (kg/m³).
+        density: f64,
+        /// Young's modulus E (Pa).
+        youngs_modulus: f64,
+        /// Poisson's ratio ν.
+        poisson_ratio: f64,
+        /// Friction angle φ (degrees).
+        friction_angle_deg: f64,
+        /// Dilatancy angle ψ (degrees).
+        dilatancy_angle_deg: f64,
+        /// Cohesion c (Pa).
+        cohesion: f64,
+        /// Tension cut-off σ_t (Pa).
+        tension_cutoff: f64,
+    },
+    /// Mohr–Coulomb with the μ(I) friction of dense granular flow
+    /// ([`crate::mpm::material::mu_i`]): sin φ(I) = sin φ_s + (sin φ_2 − sin φ_s)/(I_0/I + 1),
+    /// I = γ̇ d/√(p/ρ_s); `granflow shear` measures the three for a DEM material.
+    MohrCoulombMuI {
+        /// Density ρ (kg/m³).
+        density: f64,
+        /// Young's modulus E (Pa).
+        youngs_modulus: f64,
+        /// Poisson's ratio ν.
+        poisson_ratio: f64,
+        /// Quasi-static friction angle φ_s (degrees).
+        friction_angle_deg: f64,
+        /// Friction angle φ_2 at large I (degrees, ≥ φ_s).
+        friction_angle_2_deg: f64,
+        /// I_0: the inertial number at which sin φ is halfway from φ_s to φ_2.
+        inertial_number_0: f64,
+        /// I_max: the end of the measured dense-flow range; I is held at it above.
+        inertial_number_max: f64,
+        /// Grain diameter d (m) and grain density ρ_s (kg/m³) of the inertial number.
+        grain_diameter: f64,
+        /// See `grain_diameter`.
+        grain_density: f64,
+        /// Dilatancy angle ψ (degrees).
+        dilatancy_angle_deg: f64,
+        /// Cohesion c (Pa).
+        cohesion: f64,
+        /// Tension cut-off σ_t (Pa).
+        tension_cutoff: f64,
+    },
+}
+
+/// Column and box.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MpmColumn {
+    /// Initial width L_i (m).
+    pub width: f64,
+    /// Aspect ratio a = H_i/L_i.
+    pub aspect_ratio: f64,
+    /// Box length (m): the end wall's x.
+    pub box_length: f64,
+}
+
+/// Discretisation.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MpmSpec {
+    /// Cell size h (m).
+    pub cell_size: f64,
+    /// Points per cell along each direction, n (n² per cell).
+    pub points_per_cell: usize,
+    /// `"gimp"` or `"standard"`.
+    pub shape: ShapeKind,
+    /// `"usf"`, `"usl"` or `"musl"`.
+    pub scheme: Scheme,
+    /// Courant number C of Δt_max = C h/c.
+    pub courant: f64,
+    /// Local damping α (0: none; a collapse should use 0).
+    pub damping: f64,
+    /// Velocity transfer: `"flip"` (blended with PIC by `pic_fraction`) or `"apic"` (affine
+    /// PIC, Jiang et al. 2015; uGIMP only, `pic_fraction` must be 0).
+    pub transfer: Transfer,
+    /// PIC fraction β of the velocity update (0: pure FLIP), see
+    /// [`crate::mpm::MpmParams::pic_fraction`].
+    pub pic_fraction: f64,
+    /// Re-sort the points into cell order every this many steps (performance only).
+    pub resort_every: u64,
+}
+
+/// Conditions of the three walls.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallsSpec {
+    /// Floor y = 0.
+    pub base: WallKind,
+    /// Back wall x = 0.
+    pub back: WallKind,
+    /// End wall x = box_length.
+    pub end: WallKind,
+}
+
+/// Time stepping, outputs, stop.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MpmTimeSpec {
+    /// Time step (s); omitted: C h/c. A larger one than C h/c is refused.
+    pub dt: Option<f64>,
+    /// Interval between VTK frames, in units of τ_c.
+    pub frame_interval_tc: f64,
+    /// Interval between time-series rows, in units of τ_c.
+    pub series_interval_tc: f64,
+    /// Give up after this time, in units of τ_c.
+    pub end_tc: f64,
+    /// Rest: kinetic energy below this fraction of the initial potential energy above the floor…
+    pub rest_kinetic_fraction: f64,
+    /// …for this long, in units of τ_c.
+    pub rest_duration_tc: f64,
+}
+
+/// What [`MpmScenario::derive`] computes.
+#[derive(Clone, Debug)]
+pub struct DerivedMpm {
+    /// The material.
+    pub material: MaterialModel,
+    /// H_i = a L_i (m).
+    pub height: f64,
+    /// τ_c = √(H_i/g) (s).
+    pub tau_c: f64,
+    /// Number of material points.
+    pub points: usize,
+    /// Grid cells (x, y).
+    pub cells: [usize; 2],
+    /// CFL limit C h/c (s).
+    pub dt_cfl: f64,
+    /// P-wave speed c = √((K + 4G/3)/ρ) (m/s).
+    pub wave_speed: f64,
+}
+
+fn check_wall(field: &str, w: &WallKind) -> Result<()> {
+    if let WallKind::Friction { mu } = w {
+        non_negative(&format!("{field}.mu"), *mu)?;
+    }
+    Ok(())
+}
+
+fn elastic(field: &str, density: f64, e: f64, nu: f64) -> Result<LinearElastic> {
+    positive(&format!("{field}.density"), density)?;
+    positive(&format!("{field}.youngs_modulus"), e)?;
+    if !(nu > -1.0 && nu < 0.5) {
+        return Err(Error::config(
+            format!("{field}.poisson_ratio"),
+            format!("must be in (−1, 0.5), got {nu}"),
+        ));
+    }
+    Ok(LinearElastic {
+        density,
+        youngs_modulus: e,
+        poisson_ratio: nu,
+    })
+}
+
+impl MaterialSpec {
+    /// The material, with its values checked (fields named under `material.`).
+    pub fn build(&self) -> Result<MaterialModel> {
+        Ok(match *self {
+            MaterialSpec::LinearElastic {
+                density,
+                youngs_modulus,
+                poisson_ratio,
+            } => {
+                MaterialModel::Elastic(elastic("material", density, youngs_modulus, poisson_ratio)?)
+            }
+            MaterialSpec::MohrCoulomb {
+                density,
+                youngs_modulus,
+                poisson_ratio,
+                friction_angle_deg,
+                dilatancy_angle_deg,
+                cohesion,
+                tension_cutoff,
+            } => MaterialModel::MohrCoulomb(mohr_coulomb(
+                elastic("material", density, youngs_modulus, poisson_ratio)?,
+                friction_angle_deg,
+                dilatancy_angle_deg,
+                cohesion,
+                tension_cutoff,
+            )?),
+            MaterialSpec::MohrCoulombMuI {
+                density,
+                youngs_modulus,
+                poisson_ratio,
+                friction_angle_deg,
+                friction_angle_2_deg,
+                inertial_number_0,
+                inertial_number_max,
+                grain_diameter,
+                grain_density,
+                dilatancy_angle_deg,
+                cohesion,
+                tension_cutoff,
+            } => {
+                let base = mohr_coulomb(
+                    elastic("material", density, youngs_modulus, poisson_ratio)?,
+                    friction_angle_deg,
+                    dilatancy_angle_deg,
+                    cohesion,
+                    tension_cutoff,
+                )?;
+                if !(friction_angle_2_deg >= friction_angle_deg && friction_angle_2_deg < 90.0) {
+                    return Err(Error::config(
+                        "material.friction_angle_2_deg",
+                        format!(
+                            "must be in [φ_s = {friction_angle_deg}, 90), got {friction_angle_2_deg}"
+                        ),
+                    ));
+                }
+                for (field, v) in [
+                    ("material.inertial_number_0", inertial_number_0),
+                    ("material.inertial_number_max", inertial_number_max),
+                    ("material.grain_diameter", grain_diameter),
+                    ("material.grain_density", grain_density),
+                ] {
+                    if !(v > 0.0 && v.is_finite()) {
+                        return Err(Error::config(field, format!("must be > 0, got {v}")));
+                    }
+                }
+                MaterialModel::MuI(MuIMohrCoulomb::new(
+                    base,
+                    friction_angle_2_deg.to_radians(),
+                    [inertial_number_0, inertial_number_max],
+                    grain_diameter,
+                    grain_density,
+                ))
+            }
+        })
+    }
+}
+
+/// The Mohr–Coulomb material, its angles (degrees) and strengths checked.
+fn mohr_coulomb(
+    el: LinearElastic,
+    friction_angle_deg: f64,
+    dilatancy_angle_deg: f64,
+    cohesion: f64,
+    tension_cutoff: f64,
+) -> Result<MohrCoulomb> {
+    if !(friction_angle_deg > 0.0 && friction_angle_deg < 90.0) {
+        return Err(Error::config(
+            "material.friction_angle_deg",
+            format!("must be in (0, 90), got {friction_angle_deg}"),
+        ));
+    }
+    if !(dilatancy_angle_deg >= 0.0 && dilatancy_angle_deg <= friction_angle_deg) {
+        return Err(Error::config(
+            "material.dilatancy_angle_deg",
+            format!("must be in [0, φ = {friction_angle_deg}], got {dilatancy_angle_deg}"),
+        ));
+    }
+    non_negative("material.cohesion", cohesion)?;
+    non_negative("material.tension_cutoff", tension_cutoff)?;
+    Ok(MohrCoulomb::new(
+        el,
+        friction_angle_deg.to_radians(),
+        dilatancy_angle_deg.to_radians(),
+        cohesion,
+        tension_cutoff,
+    ))
+}
+
+/// n if `v` is within 1e-6 of the integer n ≥ 1.
+fn whole(v: f64) -> Option<usize> {
+    let n = v.round();
+    ((v - n).abs() < 1e-6 * v.max(1.0) && n >= 1.0).then_some(n as usize)
+}
+
+impl ScenarioFile for MpmScenario {
+    const KIND: Kind = Kind::Mpm;
+}
+
+impl MpmScenario {
+    /// Check every value and derive the set-up (see the module doc for what is refused).
+    pub fn derive(&self) -> Result<DerivedMpm> {
+        positive("gravity", self.gravity)?;
+        let material = self.material.build()?;
+        let c = &self.column;
+        positive("column.width", c.width)?;
+        positive("column.aspect_ratio", c.aspect_ratio)?;
+        positive("column.box_length", c.box_length)?;
+        if c.box_length <= c.width {
+            return Err(Error::config(
+                "column.box_length",
+                format!(
+                    "must exceed the column width {} m, got {} m",
+                    c.width, c.box_length
+                ),
+            ));
+        }
+        let m = &self.mpm;
+        positive("mpm.cell_size", m.cell_size)?;
+        if !(1..=8).contains(&m.points_per_cell) {
+            return Err(Error::config(
+                "mpm.points_per_cell",
+                format!(
+                    "must be 1..=8 (points per cell per direction), got {}",
+                    m.points_per_cell
+                ),
+            ));
+        }
+        if !(m.courant > 0.0 && m.courant <= 1.0) {
+            return Err(Error::config(
+                "mpm.courant",
+                format!("must be in (0, 1], got {}", m.courant),
+            ));
+        }
+        if !(m.damping >= 0.0 && m.damping < 1.0) {
+            return Err(Error::config(
+                "mpm.damping",
+                format!("must be in [0, 1), got {}", m.damping),
+            ));
+        }
+        m.transfer.check(m.shape, m.pic_fraction)?;
+        let height = c.aspect_ratio * c.width;
+        let h = m.cell_size;
+        let (Some(wc), Some(hc)) = (whole(c.width / h), whole(height / h)) else {
+            return Err(Error::config(
+                "mpm.cell_size",
+                format!(
+                    "the column {} m × {} m must be a whole number of cells of {} m",
+                    c.width, height, h
+                ),
+            ));
+        };
+        check_wall("walls.base", &self.walls.base)?;
+        check_wall("walls.back", &self.walls.back)?;
+        check_wall("walls.end", &self.walls.end)?;
+        let t = &self.time;
+        if let Some(dt) = t.dt {
+            positive("time.dt", dt)?;
+        }
+        positive("time.frame_interval_tc", t.frame_interval_tc)?;
+        positive("time.series_interval_tc", t.series_interval_tc)?;
+        positive("time.end_tc", t.end_tc)?;
+        positive("time.rest_kinetic_fraction", t.rest_kinetic_fraction)?;
+        positive("time.rest_duration_tc", t.rest_duration_tc)?;
+        let dt_cfl = cfl_step(&material, h, m.courant);
+        if let Some(dt) = t.dt {
+            if dt > dt_cfl {
+                return Err(Error::config(
+                    "time.dt",
+                    format!("Δt = {dt:e} s exceeds the CFL limit C h/c = {dt_cfl:e} s"),
+                ));
+            }
+        }
+        use crate::mpm::material::Material;
+        let n = m.points_per_cell;
+        Ok(DerivedMpm {
+            material,
+            height,
+            tau_c: (height / self.gravity).sqrt(),
+            points: wc * hc * n * n,
+            cells: [(c.box_length / h).ceil() as usize + 4, hc + 6],
+            dt_cfl,
+            wave_speed: (material.p_wave_modulus() / material.density()).sqrt(),
+        })
+    }
+
+    /// Build the solver at t = 0.
+    pub fn build(&self) -> Result<(Mpm, DerivedMpm)> {
+        let d = self.derive()?;
+        let h = self.mpm.cell_size;
+        let end = (self.column.box_length / h).ceil() * h;
+        let walls = vec![
+            Wall {
+                side: Side::Bottom,
+                position: 0.0,
+                kind: self.walls.base,
+            },
+            Wall {
+                side: Side::Left,
+                position: 0.0,
+                kind: self.walls.back,
+            },
+            Wall {
+                side: Side::Right,
+                position: end,
+                kind: self.walls.end,
+            },
+        ];
+        let grid = Grid::new(d.cells[0], d.cells[1], h, [-2.0 * h, -2.0 * h], walls);
+        let mut pts = Points::default();
+        use crate::mpm::material::Material;
+        pts.fill_rect(
+            [0.0, 0.0],
+            [self.column.width, d.height],
+            h,
+            self.mpm.points_per_cell,
+            d.material.density(),
+        );
+        let params = MpmParams {
+            shape: self.mpm.shape,
+            scheme: self.mpm.scheme,
+            gravity: [0.0, -self.gravity],
+            courant: self.mpm.courant,
+            dt: self.time.dt,
+            damping: self.mpm.damping,
+            pic_fraction: self.mpm.pic_fraction,
+            resort_every: self.mpm.resort_every,
+        };
+        let mut mpm = Mpm::new(grid, pts, d.material, params)?;
+        mpm.set_transfer(self.mpm.transfer)?;
+        Ok((mpm, d))
+    }
+}

@@ -31,14 +31,15 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::analysis::runout::{CollapseOutcome, CollapseRecord};
+use super::{run_column, steps_per_row, Column, Plan, Row, Tally};
+use crate::analysis::runout::CollapseOutcome;
 use crate::dem::packing::deposit_column;
-use crate::dem::solver::Dem;
 use crate::dem::stress::grain_stress;
-use crate::dem::walls::Wall;
-use crate::io::{write_json, write_vtu_points, CsvWriter, Field, PvdSeries};
+use crate::dem::{Dem, Energy, Wall};
+use crate::exec::Progress;
+use crate::io::{write_vtu_points, Field, PvdSeries};
 use crate::scenario::dem::spec::DemScenario;
-use crate::{Error, Result};
+use crate::Result;
 
 /// Two grains belong to the same mass when their gap is below this fraction of R_i + R_j.
 pub const CONNECT_GAP: f64 = 0.1;
@@ -59,11 +60,15 @@ pub struct CollapseSummary {
 }
 
 /// Main mass, run-out, front, height (m), and contacts per grain.
-pub(crate) struct Shape {
-    pub(crate) runout: f64,
-    pub(crate) front: f64,
-    pub(crate) height: f64,
-    contacts: Vec<f64>,
+pub struct Shape {
+    /// Run-out: the largest x + R over the main mass (m).
+    pub runout: f64,
+    /// Front: the largest x + R over all grains (m).
+    pub front: f64,
+    /// Height: the largest y + R over the main mass (m).
+    pub height: f64,
+    /// Touching contacts per grain (grains and walls).
+    pub contacts: Vec<f64>,
 }
 
 fn find(parent: &mut [u32], mut a: u32) -> u32 {
@@ -78,7 +83,7 @@ fn find(parent: &mut [u32], mut a: u32) -> u32 {
 /// Measure the deposit shape (see the module doc): main mass by near-contacts found on a
 /// uniform grid of cells 2R_max(1 + [`CONNECT_GAP`]) wide, contact counts from the touching
 /// pairs.
-pub(crate) fn shape(dem: &Dem) -> Shape {
+pub fn shape(dem: &Dem) -> Shape {
     let g = &dem.grains;
     let n = g.len();
     let mut parent: Vec<u32> = (0..n as u32).collect();
@@ -167,7 +172,7 @@ pub(crate) fn shape(dem: &Dem) -> Shape {
 }
 
 /// Write frame `k` (grains as part 0, contacts as part 1) and list it in `pvd` at `time`.
-pub(crate) fn write_frame(
+pub fn write_frame(
     dem: &Dem,
     s: &Shape,
     thickness: f64,
@@ -234,145 +239,159 @@ pub(crate) fn write_frame(
     pvd.add(time, 1, &cname)
 }
 
-/// Run the collapse described by `scenario`, writing into `out_dir` (created if missing).
-/// Returns the summary also written to `summary.json`.
-pub fn run_column_collapse(
-    scenario: &DemScenario,
-    out_dir: &Path,
-    progress: crate::exec::Progress,
-) -> Result<CollapseSummary> {
+/// A DEM column: the grains after deposition, released between the floor and the side walls.
+pub struct DemColumn {
+    /// The grains and walls.
+    pub dem: Dem,
+    e0: Energy,
+    /// Grain steps per time-series row.
+    series_steps: u64,
+    thickness: f64,
+    packing_fraction: f64,
+    deposition_wall_time_s: f64,
+}
+
+/// The DEM's time-series columns after the geometry.
+const COLUMNS: &[&str] = &[
+    "kinetic",
+    "rotational",
+    "potential",
+    "elastic",
+    "dissipated_normal",
+    "dissipated_friction",
+    "dissipated_rolling",
+    "budget_error",
+];
+
+impl DemColumn {
+    /// Relative energy budget error |E − E₀| / dissipated energy.
+    fn budget(&self, e: &Energy) -> f64 {
+        (e.total() - self.e0.total()).abs() / e.dissipated().max(1e-300)
+    }
+}
+
+/// The measurement of one row: the deposit shape and the energies.
+pub struct DemShape {
+    shape: Shape,
+    energy: Energy,
+}
+
+impl Column for DemColumn {
+    type Shape = DemShape;
+    type Summary = CollapseSummary;
+
+    fn columns(&self) -> &'static [&'static str] {
+        COLUMNS
+    }
+    fn time(&self) -> f64 {
+        self.dem.time()
+    }
+    fn measure(&mut self) -> Result<(Row, DemShape)> {
+        let e = self.dem.energy();
+        let s = shape(&self.dem);
+        let row = Row {
+            runout: s.runout,
+            front: s.front,
+            height: s.height,
+            kinetic: e.kinetic_total(),
+            values: vec![
+                e.kinetic,
+                e.rotational,
+                e.potential,
+                e.elastic(),
+                e.dissipated_normal,
+                e.dissipated_friction,
+                e.dissipated_rolling,
+                self.budget(&e),
+            ],
+        };
+        Ok((
+            row,
+            DemShape {
+                shape: s,
+                energy: e,
+            },
+        ))
+    }
+    fn write_frame(
+        &self,
+        s: &DemShape,
+        dir: &Path,
+        k: usize,
+        t: f64,
+        pvd: &mut PvdSeries,
+    ) -> Result<()> {
+        write_frame(&self.dem, &s.shape, self.thickness, dir, k, t, pvd)
+    }
+    fn advance(&mut self) -> Result<()> {
+        let dt = self.dem.dt();
+        self.dem.advance_with(self.series_steps as f64 * dt, None)
+    }
+    fn tally(&self, s: &DemShape) -> Tally {
+        Tally {
+            steps: self.dem.step_count(),
+            dt: self.dem.dt(),
+            particles: self.dem.grains.len(),
+            energy_budget_error: self.budget(&s.energy),
+            energy: s.energy.budget(&self.e0),
+        }
+    }
+    fn summary(&self, collapse: CollapseOutcome) -> CollapseSummary {
+        CollapseSummary {
+            collapse,
+            grains: self.dem.grains.len(),
+            packing_fraction: self.packing_fraction,
+            deposition_wall_time_s: self.deposition_wall_time_s,
+        }
+    }
+}
+
+/// Deposit the column of `scenario` and release it: the DEM system and the run's plan.
+pub fn column(scenario: &DemScenario) -> Result<(DemColumn, Plan<'_>)> {
     let d = scenario.derive()?;
-    std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
     let t0 = Instant::now();
-    let column = deposit_column(&d.column)?;
+    let deposit = deposit_column(&d.column)?;
     let deposition_wall_time_s = t0.elapsed().as_secs_f64();
-    let (l_i, h_i) = (scenario.column.width, column.height);
-    let gmag = scenario.gravity;
-    let tau_c = (h_i / gmag).sqrt();
     let walls = vec![
         Wall::floor(0.0),
         Wall::left(0.0),
         Wall::right(scenario.column.box_length),
     ];
-    let mut dem = Dem::new(column.grains, walls, d.params.clone())?;
+    let mut dem = Dem::new(deposit.grains, walls, d.params.clone())?;
     dem.refresh_forces();
     let e0 = dem.energy();
     let ts = &scenario.time;
-    let dt = dem.dt();
-    let series_steps = ((ts.series_interval_tc * tau_c / dt).ceil() as u64).max(1);
-    let frame_every = ((ts.frame_interval_tc / ts.series_interval_tc).round() as u64).max(1);
-    let mut csv = CsvWriter::create(
-        &out_dir.join("timeseries.csv"),
-        &[
-            "t",
-            "t_over_tc",
-            "runout",
-            "front",
-            "height",
-            "kinetic",
-            "rotational",
-            "potential",
-            "elastic",
-            "dissipated_normal",
-            "dissipated_friction",
-            "dissipated_rolling",
-            "budget_error",
-        ],
-    )?;
-    let mut pvd = PvdSeries::new(out_dir);
-    let rest_limit = ts.rest_kinetic_fraction * e0.potential;
-    let (mut rest_since, mut at_rest) = (None::<f64>, false);
-    let (mut row, mut frame) = (0u64, 0usize);
-    let mut history = Vec::new();
-    let t_run = Instant::now();
-    let budget =
-        |e: &crate::dem::Energy| (e.total() - e0.total()).abs() / e.dissipated().max(1e-300);
-    let mut last;
-    loop {
-        let e = dem.energy();
-        let s = shape(&dem);
-        let t = dem.time();
-        history.push((t, s.runout));
-        csv.row(&[
-            t,
-            t / tau_c,
-            s.runout,
-            s.front,
-            s.height,
-            e.kinetic,
-            e.rotational,
-            e.potential,
-            e.elastic(),
-            e.dissipated_normal,
-            e.dissipated_friction,
-            e.dissipated_rolling,
-            budget(&e),
-        ])?;
-        if row % frame_every == 0 {
-            write_frame(
-                &dem,
-                &s,
-                scenario.grains.thickness,
-                out_dir,
-                frame,
-                dem.time(),
-                &mut pvd,
-            )?;
-            frame += 1;
-        }
-        row += 1;
-        if e.kinetic_total() < rest_limit {
-            let since = *rest_since.get_or_insert(t);
-            if t >= tau_c && t - since >= ts.rest_duration_tc * tau_c {
-                at_rest = true;
-            }
-        } else {
-            rest_since = None;
-        }
-        last = (s, e);
-        // Progress in thousandths of τ_c, up to the end time.
-        progress((1e3 * t / tau_c) as u64, (1e3 * ts.end_tc) as u64);
-        if at_rest || t >= ts.end_tc * tau_c {
-            break;
-        }
-        dem.advance_with(series_steps as f64 * dt, None)?;
-    }
-    let wall_time_s = t_run.elapsed().as_secs_f64();
-    if (row - 1) % frame_every != 0 {
-        write_frame(
-            &dem,
-            &last.0,
-            scenario.grains.thickness,
-            out_dir,
-            frame,
-            dem.time(),
-            &mut pvd,
-        )?;
-    }
-    let (s, e) = last;
-    let collapse = CollapseOutcome::from(CollapseRecord {
+    let plan = Plan {
         name: &scenario.name,
-        l_i,
-        h_i,
-        gravity: gmag,
-        history: &history,
-        h_f: s.height,
-        rest_since,
-        at_rest,
-        t_end: dem.time(),
-        dt,
-        steps: dem.step_count(),
-        wall_time_s,
-        particles: dem.grains.len(),
-        energy_budget_error: budget(&e),
-        energy: e.budget(&e0),
-    });
-    let summary = CollapseSummary {
-        collapse,
-        grains: dem.grains.len(),
-        packing_fraction: column.packing_fraction,
+        l_i: scenario.column.width,
+        h_i: deposit.height,
+        gravity: scenario.gravity,
+        potential: e0.potential,
+        series_interval_tc: ts.series_interval_tc,
+        frame_interval_tc: ts.frame_interval_tc,
+        end_tc: ts.end_tc,
+        rest_kinetic_fraction: ts.rest_kinetic_fraction,
+        rest_duration_tc: ts.rest_duration_tc,
+    };
+    let series_steps = steps_per_row(ts.series_interval_tc, plan.tau_c(), dem.dt());
+    let column = DemColumn {
+        dem,
+        e0,
+        series_steps,
+        thickness: scenario.grains.thickness,
+        packing_fraction: deposit.packing_fraction,
         deposition_wall_time_s,
     };
-    write_json(&out_dir.join("summary.json"), &summary)?;
-    Ok(summary)
+    Ok((column, plan))
+}
+
+/// Run the collapse described by `scenario`, writing into `out_dir` (created if missing).
+/// Returns the summary also written to `summary.json`.
+pub fn run_column_collapse(
+    scenario: &DemScenario,
+    out_dir: &Path,
+    progress: Progress,
+) -> Result<CollapseSummary> {
+    let (column, plan) = column(scenario)?;
+    run_column(column, &plan, out_dir, progress)
 }

@@ -1,5 +1,205 @@
-//! The column-collapse runners.
+//! The column-collapse runner, one for every solid: deposit or build the column, release it,
+//! follow it to rest, and write
+//!
+//! * `series.pvd` with the frames of the solid (and of the fluid, when there is one);
+//! * `timeseries.csv`: `t`, `t_over_tc`, `runout`, `front`, `height`, then the solid's own
+//!   columns (energies, pore pressure, …);
+//! * `summary.json`: the solver-independent [`CollapseOutcome`] (the same keys for every
+//!   solid, so the runs compare directly) and the solid's own keys.
+//!
+//! What differs between the solids is a [`Column`]: [`dem`] (grains), [`mpm`] (material
+//! points), [`submerged`] (grains in a liquid). The loop is [`run_column`]: one time-series
+//! row per `series_interval_tc`, a frame every `frame_interval_tc`, and the end when the
+//! kinetic energy has stayed below `rest_kinetic_fraction` × the initial potential energy
+//! above the floor for `rest_duration_tc` τ_c (and t ≥ 1 τ_c; reported as `rest_time_tc`), or
+//! at `end_tc` τ_c. τ_c = √(H_i/g) with H_i the initial (deposited) height; the run-out
+//! definitions are in each solid's module and [`crate::analysis::runout`].
 
 pub mod dem;
 pub mod mpm;
 pub mod submerged;
+
+use std::path::Path;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::analysis::runout::{CollapseOutcome, CollapseRecord, EnergyBudget};
+use crate::exec::Progress;
+use crate::io::{write_json, CsvWriter, PvdSeries};
+use crate::{Error, Result};
+
+/// One time-series row of a collapsing column.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Run-out L(t) of the main mass (m, from the back wall).
+    pub runout: f64,
+    /// Front: the farthest point of any part of the solid (m).
+    pub front: f64,
+    /// Height H(t) of the main mass (m).
+    pub height: f64,
+    /// Kinetic energy the rest test compares with the initial potential energy (J).
+    pub kinetic: f64,
+    /// The solid's own columns, in the order of [`Column::columns`].
+    pub values: Vec<f64>,
+}
+
+/// The final state of a run, for [`CollapseOutcome`].
+#[derive(Clone, Copy, Debug)]
+pub struct Tally {
+    /// Steps of the solid taken (the coupled steps for a submerged run).
+    pub steps: u64,
+    /// Their size (s).
+    pub dt: f64,
+    /// Grains or material points.
+    pub particles: usize,
+    /// |E − E₀| / dissipated energy (NaN where the budget is not closed, e.g. in a liquid).
+    pub energy_budget_error: f64,
+    /// Where the released potential energy went.
+    pub energy: EnergyBudget,
+}
+
+/// A collapsing solid as the runner drives it.
+pub trait Column {
+    /// What a frame needs from the measurement of its row (e.g. contact counts).
+    type Shape;
+    /// What `summary.json` holds beside the [`CollapseOutcome`].
+    type Summary: Serialize;
+
+    /// The time-series columns after `t, t_over_tc, runout, front, height`.
+    fn columns(&self) -> &'static [&'static str];
+    /// Simulated time since the release (s).
+    fn time(&self) -> f64;
+    /// Measure the state now: its time-series row and what a frame of it needs.
+    fn measure(&mut self) -> Result<(Row, Self::Shape)>;
+    /// Write frame `k` of the state measured as `shape` at time `t` into `dir`, listed in `pvd`.
+    fn write_frame(
+        &self,
+        shape: &Self::Shape,
+        dir: &Path,
+        k: usize,
+        t: f64,
+        pvd: &mut PvdSeries,
+    ) -> Result<()>;
+    /// Advance by one time-series interval.
+    fn advance(&mut self) -> Result<()>;
+    /// Steps, particles and energy of the state measured last.
+    fn tally(&self, shape: &Self::Shape) -> Tally;
+    /// The summary: `collapse` and the solid's own keys.
+    fn summary(&self, collapse: CollapseOutcome) -> Self::Summary;
+}
+
+/// The column and the output schedule of a run (SI; times in τ_c).
+#[derive(Clone, Copy, Debug)]
+pub struct Plan<'a> {
+    /// Scenario name.
+    pub name: &'a str,
+    /// Initial width L_i (m).
+    pub l_i: f64,
+    /// Initial height H_i (m).
+    pub h_i: f64,
+    /// Gravity g (m/s²), for τ_c = √(H_i/g).
+    pub gravity: f64,
+    /// Initial potential energy above the floor (J), the scale of the rest test.
+    pub potential: f64,
+    /// Time-series rows every this many τ_c (the solid advances by as much between rows).
+    pub series_interval_tc: f64,
+    /// Frames every this many τ_c (rounded to whole rows).
+    pub frame_interval_tc: f64,
+    /// Stop at this time (τ_c).
+    pub end_tc: f64,
+    /// At rest when the kinetic energy stays below this fraction of `potential` …
+    pub rest_kinetic_fraction: f64,
+    /// … for this long (τ_c).
+    pub rest_duration_tc: f64,
+}
+
+impl Plan<'_> {
+    /// τ_c = √(H_i/g) (s).
+    pub fn tau_c(&self) -> f64 {
+        (self.h_i / self.gravity).sqrt()
+    }
+}
+
+/// Run `column` to rest by `plan`, writing into `out_dir` (created if missing); returns the
+/// summary also written to `summary.json`. `progress` is told the time in thousandths of τ_c.
+pub fn run_column<C: Column>(
+    mut column: C,
+    plan: &Plan,
+    out_dir: &Path,
+    progress: Progress,
+) -> Result<C::Summary> {
+    std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
+    let tau_c = plan.tau_c();
+    let frame_every = ((plan.frame_interval_tc / plan.series_interval_tc).round() as u64).max(1);
+    let mut header = vec!["t", "t_over_tc", "runout", "front", "height"];
+    header.extend_from_slice(column.columns());
+    let mut csv = CsvWriter::create(&out_dir.join("timeseries.csv"), &header)?;
+    let mut pvd = PvdSeries::new(out_dir);
+    let rest_limit = plan.rest_kinetic_fraction * plan.potential;
+    let (mut rest_since, mut at_rest) = (None::<f64>, false);
+    let (mut row, mut frame) = (0u64, 0usize);
+    let mut history = Vec::new();
+    let t_run = Instant::now();
+    let mut values = Vec::with_capacity(header.len());
+    let (mut last, mut height);
+    loop {
+        let t = column.time();
+        let (r, shape) = column.measure()?;
+        history.push((t, r.runout));
+        values.clear();
+        values.extend([t, t / tau_c, r.runout, r.front, r.height]);
+        values.extend_from_slice(&r.values);
+        csv.row(&values)?;
+        if row % frame_every == 0 {
+            column.write_frame(&shape, out_dir, frame, t, &mut pvd)?;
+            frame += 1;
+        }
+        row += 1;
+        if r.kinetic < rest_limit {
+            let since = *rest_since.get_or_insert(t);
+            if t >= tau_c && t - since >= plan.rest_duration_tc * tau_c {
+                at_rest = true;
+            }
+        } else {
+            rest_since = None;
+        }
+        (last, height) = (shape, r.height);
+        progress((1e3 * t / tau_c) as u64, (1e3 * plan.end_tc) as u64);
+        if at_rest || t >= plan.end_tc * tau_c {
+            break;
+        }
+        column.advance()?;
+    }
+    let wall_time_s = t_run.elapsed().as_secs_f64();
+    let t_end = column.time();
+    if (row - 1) % frame_every != 0 {
+        column.write_frame(&last, out_dir, frame, t_end, &mut pvd)?;
+    }
+    let tally = column.tally(&last);
+    let collapse = CollapseOutcome::from(CollapseRecord {
+        name: plan.name,
+        l_i: plan.l_i,
+        h_i: plan.h_i,
+        gravity: plan.gravity,
+        history: &history,
+        h_f: height,
+        rest_since,
+        at_rest,
+        t_end,
+        dt: tally.dt,
+        steps: tally.steps,
+        wall_time_s,
+        particles: tally.particles,
+        energy_budget_error: tally.energy_budget_error,
+        energy: tally.energy,
+    });
+    let summary = column.summary(collapse);
+    write_json(&out_dir.join("summary.json"), &summary)?;
+    Ok(summary)
+}
+
+/// Steps of `dt` per time-series row: those that cover `interval_tc` τ_c (at least one).
+pub(crate) fn steps_per_row(interval_tc: f64, tau_c: f64, dt: f64) -> u64 {
+    ((interval_tc * tau_c / dt).ceil() as u64).max(1)
+}

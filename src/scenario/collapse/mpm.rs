@@ -22,15 +22,16 @@
 //! `rest_duration_tc` τ_c (and t ≥ 1 τ_c; reported as `rest_time_tc`), or at `end_tc` τ_c.
 
 use std::path::Path;
-use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::analysis::runout::{CollapseOutcome, CollapseRecord};
-use crate::io::{write_json, write_vti, write_vtu_points, CsvWriter, Field, ImageGrid, PvdSeries};
+use super::{run_column, steps_per_row, Column, Plan, Row, Tally};
+use crate::analysis::runout::CollapseOutcome;
+use crate::exec::Progress;
+use crate::io::{write_vti, write_vtu_points, Field, ImageGrid, PvdSeries};
 use crate::mpm::solver::{Mpm, MpmEnergy};
 use crate::scenario::mpm::spec::MpmScenario;
-use crate::{Error, Result};
+use crate::Result;
 
 /// What an MPM collapse run reports (`summary.json`): the solver-independent outcome (the
 /// same keys as the DEM's, so the two compare directly), the DEM's other keys where they have
@@ -220,130 +221,143 @@ fn write_frame(mpm: &Mpm, dir: &Path, k: usize, pvd: &mut PvdSeries) -> Result<(
     pvd.add(mpm.time(), 1, &gname)
 }
 
+/// An MPM column: the material points released between the floor and the walls.
+pub struct MpmColumn {
+    /// The continuum.
+    pub mpm: Mpm,
+    e0: MpmEnergy,
+    /// Steps per time-series row.
+    series_steps: u64,
+}
+
+/// The MPM's time-series columns after the geometry (the DEM's names where they apply).
+const COLUMNS: &[&str] = &[
+    "kinetic",
+    "potential",
+    "elastic",
+    "dissipated_plastic",
+    "dissipated_normal",
+    "dissipated_friction",
+    "dissipated_damping",
+    "budget_error",
+];
+
+impl MpmColumn {
+    /// Relative energy budget error, 0 while almost nothing is dissipated (t ≈ 0, where the
+    /// ratio would be round-off over round-off).
+    fn budget(&self, e: &MpmEnergy) -> f64 {
+        let tiny = 1e-9 * self.e0.total().abs();
+        if e.dissipated() > tiny {
+            (e.total() - self.e0.total()).abs() / e.dissipated()
+        } else {
+            0.0
+        }
+    }
+}
+
+impl Column for MpmColumn {
+    type Shape = MpmEnergy;
+    type Summary = MpmCollapseSummary;
+
+    fn columns(&self) -> &'static [&'static str] {
+        COLUMNS
+    }
+    fn time(&self) -> f64 {
+        self.mpm.time()
+    }
+    fn measure(&mut self) -> Result<(Row, MpmEnergy)> {
+        let e = self.mpm.energy();
+        let s = shape(&self.mpm);
+        let row = Row {
+            runout: s.runout,
+            front: s.front,
+            height: s.height,
+            kinetic: e.kinetic,
+            values: vec![
+                e.kinetic,
+                e.potential,
+                e.elastic,
+                e.plastic,
+                e.boundary_normal,
+                e.boundary_friction,
+                e.damping,
+                self.budget(&e),
+            ],
+        };
+        Ok((row, e))
+    }
+    fn write_frame(
+        &self,
+        _: &MpmEnergy,
+        dir: &Path,
+        k: usize,
+        _: f64,
+        pvd: &mut PvdSeries,
+    ) -> Result<()> {
+        write_frame(&self.mpm, dir, k, pvd)
+    }
+    fn advance(&mut self) -> Result<()> {
+        self.mpm.steps(self.series_steps)
+    }
+    fn tally(&self, e: &MpmEnergy) -> Tally {
+        Tally {
+            steps: self.mpm.step_count(),
+            dt: self.mpm.dt(),
+            particles: self.mpm.points.len(),
+            energy_budget_error: self.budget(e),
+            energy: e.budget(&self.e0),
+        }
+    }
+    fn summary(&self, collapse: CollapseOutcome) -> MpmCollapseSummary {
+        let n = self.mpm.points.len();
+        MpmCollapseSummary {
+            collapse,
+            grains: n,
+            packing_fraction: None,
+            deposition_wall_time_s: 0.0,
+            solver: "mpm".into(),
+            points: n,
+            cells: [self.mpm.grid.nx, self.mpm.grid.ny],
+            cell_size: self.mpm.grid.h,
+        }
+    }
+}
+
+/// Build the column of `scenario`: the MPM system and the run's plan.
+pub fn column(scenario: &MpmScenario) -> Result<(MpmColumn, Plan<'_>)> {
+    let (mpm, d) = scenario.build()?;
+    let e0 = mpm.energy();
+    let ts = &scenario.time;
+    let plan = Plan {
+        name: &scenario.name,
+        l_i: scenario.column.width,
+        h_i: d.height,
+        gravity: scenario.gravity,
+        potential: e0.potential,
+        series_interval_tc: ts.series_interval_tc,
+        frame_interval_tc: ts.frame_interval_tc,
+        end_tc: ts.end_tc,
+        rest_kinetic_fraction: ts.rest_kinetic_fraction,
+        rest_duration_tc: ts.rest_duration_tc,
+    };
+    let series_steps = steps_per_row(ts.series_interval_tc, d.tau_c, mpm.dt());
+    Ok((
+        MpmColumn {
+            mpm,
+            e0,
+            series_steps,
+        },
+        plan,
+    ))
+}
+
 /// Run the collapse described by `scenario`, writing into `out_dir` (created if missing).
 /// Returns the summary also written to `summary.json`.
 pub fn run_column_collapse(
     scenario: &MpmScenario,
     out_dir: &Path,
-    progress: crate::exec::Progress,
+    progress: Progress,
 ) -> Result<MpmCollapseSummary> {
-    let (mut mpm, d) = scenario.build()?;
-    std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
-    let (l_i, h_i, tau_c) = (scenario.column.width, d.height, d.tau_c);
-    let e0 = mpm.energy();
-    let ts = &scenario.time;
-    let dt = mpm.dt();
-    let series_steps = ((ts.series_interval_tc * tau_c / dt).ceil() as u64).max(1);
-    let frame_every = ((ts.frame_interval_tc / ts.series_interval_tc).round() as u64).max(1);
-    let mut csv = CsvWriter::create(
-        &out_dir.join("timeseries.csv"),
-        &[
-            "t",
-            "t_over_tc",
-            "runout",
-            "front",
-            "height",
-            "kinetic",
-            "potential",
-            "elastic",
-            "dissipated_plastic",
-            "dissipated_normal",
-            "dissipated_friction",
-            "dissipated_damping",
-            "budget_error",
-        ],
-    )?;
-    let mut pvd = PvdSeries::new(out_dir);
-    let rest_limit = ts.rest_kinetic_fraction * e0.potential;
-    let (mut rest_since, mut at_rest) = (None::<f64>, false);
-    let (mut row, mut frame) = (0u64, 0usize);
-    let mut history = Vec::new();
-    let t_run = Instant::now();
-    // Relative to the booked dissipation; 0 while almost nothing is dissipated (t ≈ 0, where
-    // the ratio would be round-off over round-off).
-    let tiny = 1e-9 * e0.total().abs();
-    let budget = |e: &MpmEnergy| {
-        if e.dissipated() > tiny {
-            (e.total() - e0.total()).abs() / e.dissipated()
-        } else {
-            0.0
-        }
-    };
-    let mut last;
-    loop {
-        let e = mpm.energy();
-        let s = shape(&mpm);
-        let t = mpm.time();
-        history.push((t, s.runout));
-        csv.row(&[
-            t,
-            t / tau_c,
-            s.runout,
-            s.front,
-            s.height,
-            e.kinetic,
-            e.potential,
-            e.elastic,
-            e.plastic,
-            e.boundary_normal,
-            e.boundary_friction,
-            e.damping,
-            budget(&e),
-        ])?;
-        if row % frame_every == 0 {
-            write_frame(&mpm, out_dir, frame, &mut pvd)?;
-            frame += 1;
-        }
-        row += 1;
-        if e.kinetic < rest_limit {
-            let since = *rest_since.get_or_insert(t);
-            if t >= tau_c && t - since >= ts.rest_duration_tc * tau_c {
-                at_rest = true;
-            }
-        } else {
-            rest_since = None;
-        }
-        last = (s, e);
-        progress((1e3 * t / tau_c) as u64, (1e3 * ts.end_tc) as u64);
-        if at_rest || t >= ts.end_tc * tau_c {
-            break;
-        }
-        mpm.steps(series_steps)?;
-    }
-    let wall_time_s = t_run.elapsed().as_secs_f64();
-    if (row - 1) % frame_every != 0 {
-        write_frame(&mpm, out_dir, frame, &mut pvd)?;
-    }
-    let (s, e) = last;
-    let steps = mpm.step_count();
-    let n = mpm.points.len();
-    let collapse = CollapseOutcome::from(CollapseRecord {
-        name: &scenario.name,
-        l_i,
-        h_i,
-        gravity: scenario.gravity,
-        history: &history,
-        h_f: s.height,
-        rest_since,
-        at_rest,
-        t_end: mpm.time(),
-        dt,
-        steps,
-        wall_time_s,
-        particles: n,
-        energy_budget_error: budget(&e),
-        energy: e.budget(&e0),
-    });
-    let summary = MpmCollapseSummary {
-        collapse,
-        grains: n,
-        packing_fraction: None,
-        deposition_wall_time_s: 0.0,
-        solver: "mpm".into(),
-        points: n,
-        cells: [mpm.grid.nx, mpm.grid.ny],
-        cell_size: mpm.grid.h,
-    };
-    write_json(&out_dir.join("summary.json"), &summary)?;
-    Ok(summary)
+    let (column, plan) = column(scenario)?;
+    run_column(column, &plan, out_dir, progress)
 }

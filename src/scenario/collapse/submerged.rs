@@ -36,18 +36,22 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::analysis::runout::{CollapseOutcome, CollapseRecord};
+use super::dem::{shape, write_frame, Shape};
+use super::{run_column, Column, Plan, Row, Tally};
+use crate::analysis::runout::CollapseOutcome;
 use crate::coupling::{
     reduced_gravity, CellForces, Coupled, CoupledFluid, DiskCover, Exchange, Grid, LaddMap,
     SolidCover,
 };
 use crate::dem::packing::deposit_column;
 use crate::dem::scale::GrainView;
-use crate::dem::{Dem, ExternalLoads, Wall};
-use crate::io::{write_json, write_vti, CsvWriter, Field, ImageGrid, PvdSeries};
-use crate::lbm::{Edge, Edges, Fluid, FluidModel, Lattice, Lbm, Macroscopic, Obstacles, Real};
+use crate::dem::{Dem, Energy, ExternalLoads, Wall};
+use crate::exec::Progress;
+use crate::io::{write_vti, Field, ImageGrid, PvdSeries};
+use crate::lbm::{
+    Edge, Edges, Fluid, FluidModel, Lattice, Lbm, Macroscopic, Obstacles, Real, STOP_MACH,
+};
 use crate::scale::Scale;
-use crate::scenario::collapse::dem::{shape, write_frame};
 use crate::scenario::fluid::Precision;
 use crate::scenario::submerged::spec::{CouplingMethod, DerivedSubmerged, SubmergedScenario};
 use crate::units::CS2;
@@ -290,17 +294,180 @@ impl FluidFields {
     }
 }
 
-fn run_typed<T: Real>(
-    scenario: &SubmergedScenario,
-    d: &DerivedSubmerged,
-    out_dir: &Path,
-    progress: crate::exec::Progress,
-) -> Result<SubmergedSummary> {
-    std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
+/// The time-series columns after the geometry: the DEM's energies with the reduced gravity
+/// (no budget: the fluid's work is not tracked) and the fluid's.
+const COLUMNS: &[&str] = &[
+    "kinetic",
+    "rotational",
+    "potential",
+    "elastic",
+    "dissipated_normal",
+    "dissipated_friction",
+    "dissipated_rolling",
+    "pore_pressure_base",
+    "drag_x",
+    "drag_y",
+    "fluid_kinetic",
+    "max_mach",
+];
+
+/// A submerged column: the grains and the liquid, coupled.
+pub struct SubmergedColumn<'a, T: Real> {
+    scenario: &'a SubmergedScenario,
+    derived: &'a DerivedSubmerged,
+    /// The coupled fluid and grains.
+    pub coupled: Coupled<CoupledFluid<T>, Dem, SlabCover>,
+    fields: FluidFields,
+    e0: Energy,
+    /// Coupled steps per time-series row.
+    series_steps: u64,
+    /// (t, base excess pore pressure) of every row.
+    pore: Vec<(f64, f64)>,
+    max_mach: f64,
+    h_i: f64,
+    packing_fraction: f64,
+    deposition_wall_time_s: f64,
+}
+
+impl<T: Real> Column for SubmergedColumn<'_, T> {
+    type Shape = Shape;
+    type Summary = SubmergedSummary;
+
+    fn columns(&self) -> &'static [&'static str] {
+        COLUMNS
+    }
+    fn time(&self) -> f64 {
+        self.coupled.steps as f64 * self.derived.units.dt
+    }
+    fn measure(&mut self) -> Result<(Row, Shape)> {
+        let t = self.time();
+        let u = self.derived.units;
+        let c = &mut self.coupled;
+        self.fields.refresh(c);
+        let e = c.solid.energy();
+        let s = shape(&c.solid);
+        let p_base = self.fields.base(&u);
+        let mach = self.fields.max_mach();
+        self.max_mach = self.max_mach.max(mach);
+        let loads = c.solid_input();
+        // `+ 0.0`: an empty sum is −0.0 (before the first step).
+        let drag_x = loads.fx.iter().sum::<f64>() + 0.0;
+        let drag_y = loads.fy.iter().sum::<f64>() + 0.0;
+        self.pore.push((t, p_base));
+        let row = Row {
+            runout: s.runout,
+            front: s.front,
+            height: s.height,
+            kinetic: e.kinetic_total(),
+            values: vec![
+                e.kinetic,
+                e.rotational,
+                e.potential,
+                e.elastic(),
+                e.dissipated_normal,
+                e.dissipated_friction,
+                e.dissipated_rolling,
+                p_base,
+                drag_x,
+                drag_y,
+                self.fields.kinetic(&u, self.scenario.grains.thickness),
+                mach,
+            ],
+        };
+        Ok((row, s))
+    }
+    fn write_frame(
+        &self,
+        s: &Shape,
+        dir: &Path,
+        k: usize,
+        t: f64,
+        pvd: &mut PvdSeries,
+    ) -> Result<()> {
+        let sc = self.scenario;
+        write_frame(&self.coupled.solid, s, sc.grains.thickness, dir, k, t, pvd)?;
+        let name = format!("fluid_{k:06}.vti");
+        let hydro = sc.fluid.density * sc.gravity;
+        self.fields
+            .write(&self.derived.units, hydro, sc.fluid.depth, &dir.join(&name))?;
+        pvd.add(t, 2, &name)
+    }
+    fn advance(&mut self) -> Result<()> {
+        for _ in 0..self.series_steps {
+            self.coupled.step()?;
+        }
+        Fluid::check_stable(&self.coupled.fluid.lbm, STOP_MACH)
+    }
+    fn tally(&self, _: &Shape) -> Tally {
+        let c = &self.coupled;
+        Tally {
+            steps: c.steps,
+            dt: self.derived.units.dt,
+            particles: c.solid.grains.len(),
+            energy_budget_error: f64::NAN,
+            // The grains' budget; what the liquid took is in the DEM's external work.
+            energy: c.solid.energy().budget(&self.e0),
+        }
+    }
+    fn summary(&self, collapse: CollapseOutcome) -> SubmergedSummary {
+        let (sc, d, c) = (self.scenario, self.derived, &self.coupled);
+        let (f, u) = (&sc.fluid, d.units);
+        let tau_c = (self.h_i / sc.gravity).sqrt();
+        let sound = u.dx / (3f64.sqrt() * u.dt);
+        let t_a = 2.0 * sc.column.box_length.max(f.depth) / sound;
+        let mean_until = |t1: f64| {
+            let v: Vec<f64> = self
+                .pore
+                .iter()
+                .filter(|p| p.0 > 0.0 && p.0 <= t1)
+                .map(|p| p.1)
+                .collect();
+            v.iter().sum::<f64>() / v.len().max(1) as f64
+        };
+        let [nx, ny] = d.cells;
+        let mlups = (nx * ny) as f64 * c.steps as f64 / collapse.wall_time_s.max(1e-9) / 1e6;
+        SubmergedSummary {
+            collapse,
+            grains: c.solid.grains.len(),
+            packing_fraction: self.packing_fraction,
+            deposition_wall_time_s: self.deposition_wall_time_s,
+            fluid: FluidSummary {
+                method: sc.coupling.method,
+                radius_factor: sc.coupling.radius_factor,
+                density: f.density,
+                viscosity: f.viscosity,
+                cells: d.cells,
+                dx: u.dx,
+                dt: u.dt,
+                tau: u.tau,
+                precision: T::NAME,
+                subcycles: c.last_subcycles,
+                reduced_gravity: d.reduced_gravity,
+                mach_design: d.mach,
+                max_mach: self.max_mach,
+                pressure_scale: (sc.grains.density - f.density)
+                    * self.packing_fraction
+                    * sc.gravity
+                    * self.h_i,
+                acoustic_period_tc: t_a / tau_c,
+                pore_pressure_early_mean: mean_until(t_a),
+                pore_pressure_early_mean_2ta: mean_until(2.0 * t_a),
+                mlups,
+            },
+        }
+    }
+}
+
+/// Deposit the column of `scenario` dry, fill the tank and couple grains and liquid: the
+/// system and the run's plan.
+pub fn column<'a, T: Real>(
+    scenario: &'a SubmergedScenario,
+    d: &'a DerivedSubmerged,
+) -> Result<(SubmergedColumn<'a, T>, Plan<'a>)> {
     let t0 = Instant::now();
-    let column = deposit_column(&d.dem.column)?;
+    let deposit = deposit_column(&d.dem.column)?;
     let deposition_wall_time_s = t0.elapsed().as_secs_f64();
-    let (l_i, h_i) = (scenario.column.width, column.height);
+    let (l_i, h_i) = (scenario.column.width, deposit.height);
     let f = &scenario.fluid;
     if h_i + scenario.grains.d_max > f.depth {
         return Err(Error::config(
@@ -312,7 +479,6 @@ fn run_typed<T: Real>(
         ));
     }
     let gmag = scenario.gravity;
-    let tau_c = (h_i / gmag).sqrt();
     let walls = vec![
         Wall::floor(0.0),
         Wall::left(0.0),
@@ -320,7 +486,7 @@ fn run_typed<T: Real>(
     ];
     let mut params = d.dem.params.clone();
     params.gravity = reduced_gravity([0.0, -gmag], f.density, scenario.grains.density);
-    let dem = Dem::new(column.grains, walls, params)?;
+    let dem = Dem::new(deposit.grains, walls, params)?;
     let [nx, ny] = d.cells;
     let u = d.units;
     let wall = Edge::Wall { velocity: [0.0; 2] };
@@ -361,31 +527,8 @@ fn run_typed<T: Real>(
     c.solid.refresh_forces();
     let e0 = c.solid.energy();
     let ts = &scenario.time;
-    let dt = u.dt;
-    let series_steps = ((ts.series_interval_tc * tau_c / dt).round() as u64).max(1);
-    let frame_every = ((ts.frame_interval_tc / ts.series_interval_tc).round() as u64).max(1);
-    let mut csv = CsvWriter::create(
-        &out_dir.join("timeseries.csv"),
-        &[
-            "t",
-            "t_over_tc",
-            "runout",
-            "front",
-            "height",
-            "kinetic",
-            "rotational",
-            "potential",
-            "elastic",
-            "dissipated_normal",
-            "dissipated_friction",
-            "dissipated_rolling",
-            "pore_pressure_base",
-            "drag_x",
-            "drag_y",
-            "fluid_kinetic",
-            "max_mach",
-        ],
-    )?;
+    let tau_c = (h_i / gmag).sqrt();
+    let series_steps = ((ts.series_interval_tc * tau_c / u.dt).round() as u64).max(1);
     let strip: Vec<usize> = (0..nx * ny)
         .filter(|&cell| {
             let (x, y) = (
@@ -401,154 +544,47 @@ fn run_typed<T: Real>(
             "no lattice cell centre lies in the base strip under the column",
         ));
     }
-    let mut ff = FluidFields {
+    let fields = FluidFields {
         m: Macroscopic::default(),
         eps: vec![0.0; nx * ny],
         cover: SolidCover::default(),
         view: GrainView::default(),
         strip,
     };
-    let mut pvd = PvdSeries::new(out_dir);
-    let rest_limit = ts.rest_kinetic_fraction * e0.potential;
-    let (mut rest_since, mut at_rest) = (None::<f64>, false);
-    let (mut row, mut frame) = (0u64, 0usize);
-    let mut history = Vec::new();
-    let mut pore = Vec::new();
-    let mut max_mach: f64 = 0.0;
-    let hydro = f.density * gmag;
-    let t_run = Instant::now();
-    let frame_out = |c: &Coupled<CoupledFluid<T>, Dem, SlabCover>,
-                     ff: &FluidFields,
-                     s: &crate::scenario::collapse::dem::Shape,
-                     k: usize,
-                     t: f64,
-                     pvd: &mut PvdSeries|
-     -> Result<()> {
-        write_frame(&c.solid, s, scenario.grains.thickness, out_dir, k, t, pvd)?;
-        let name = format!("fluid_{k:06}.vti");
-        ff.write(&u, hydro, f.depth, &out_dir.join(&name))?;
-        pvd.add(t, 2, &name)
-    };
-    let mut last;
-    loop {
-        let t = c.steps as f64 * dt;
-        ff.refresh(&mut c);
-        let e = c.solid.energy();
-        let s = shape(&c.solid);
-        let p_base = ff.base(&u);
-        let mach = ff.max_mach();
-        max_mach = max_mach.max(mach);
-        let loads = c.solid_input();
-        // `+ 0.0`: an empty sum is −0.0 (before the first step).
-        let drag_x = loads.fx.iter().sum::<f64>() + 0.0;
-        let drag_y = loads.fy.iter().sum::<f64>() + 0.0;
-        history.push((t, s.runout));
-        pore.push((t, p_base));
-        csv.row(&[
-            t,
-            t / tau_c,
-            s.runout,
-            s.front,
-            s.height,
-            e.kinetic,
-            e.rotational,
-            e.potential,
-            e.elastic(),
-            e.dissipated_normal,
-            e.dissipated_friction,
-            e.dissipated_rolling,
-            p_base,
-            drag_x,
-            drag_y,
-            ff.kinetic(&u, scenario.grains.thickness),
-            mach,
-        ])?;
-        if row % frame_every == 0 {
-            frame_out(&c, &ff, &s, frame, t, &mut pvd)?;
-            frame += 1;
-        }
-        row += 1;
-        if e.kinetic_total() < rest_limit {
-            let since = *rest_since.get_or_insert(t);
-            if t >= tau_c && t - since >= ts.rest_duration_tc * tau_c {
-                at_rest = true;
-            }
-        } else {
-            rest_since = None;
-        }
-        last = s;
-        progress((1e3 * t / tau_c) as u64, (1e3 * ts.end_tc) as u64);
-        if at_rest || t >= ts.end_tc * tau_c {
-            break;
-        }
-        for _ in 0..series_steps {
-            c.step()?;
-        }
-        Fluid::check_stable(&c.fluid.lbm, crate::lbm::STOP_MACH)?;
-    }
-    let wall_time_s = t_run.elapsed().as_secs_f64();
-    let t_end = c.steps as f64 * dt;
-    if (row - 1) % frame_every != 0 {
-        frame_out(&c, &ff, &last, frame, t_end, &mut pvd)?;
-    }
-    let grains = c.solid.grains.len();
-    let collapse = CollapseOutcome::from(CollapseRecord {
+    let plan = Plan {
         name: &scenario.name,
         l_i,
         h_i,
         gravity: gmag,
-        history: &history,
-        h_f: last.height,
-        rest_since,
-        at_rest,
-        t_end,
-        dt,
-        steps: c.steps,
-        wall_time_s,
-        particles: grains,
-        energy_budget_error: f64::NAN,
-        // The grains' budget; what the liquid took is in the DEM's external work.
-        energy: c.solid.energy().budget(&e0),
-    });
-    let sound = u.dx / (3f64.sqrt() * dt);
-    let t_a = 2.0 * scenario.column.box_length.max(f.depth) / sound;
-    let mean_until = |t1: f64| {
-        let v: Vec<f64> = pore
-            .iter()
-            .filter(|p| p.0 > 0.0 && p.0 <= t1)
-            .map(|p| p.1)
-            .collect();
-        v.iter().sum::<f64>() / v.len().max(1) as f64
+        potential: e0.potential,
+        series_interval_tc: ts.series_interval_tc,
+        frame_interval_tc: ts.frame_interval_tc,
+        end_tc: ts.end_tc,
+        rest_kinetic_fraction: ts.rest_kinetic_fraction,
+        rest_duration_tc: ts.rest_duration_tc,
     };
-    let summary = SubmergedSummary {
-        collapse,
-        grains,
-        packing_fraction: column.packing_fraction,
+    let column = SubmergedColumn {
+        scenario,
+        derived: d,
+        coupled: c,
+        fields,
+        e0,
+        series_steps,
+        pore: Vec::new(),
+        max_mach: 0.0,
+        h_i,
+        packing_fraction: deposit.packing_fraction,
         deposition_wall_time_s,
-        fluid: FluidSummary {
-            method: scenario.coupling.method,
-            radius_factor: scenario.coupling.radius_factor,
-            density: f.density,
-            viscosity: f.viscosity,
-            cells: d.cells,
-            dx: u.dx,
-            dt,
-            tau: u.tau,
-            precision: T::NAME,
-            subcycles: c.last_subcycles,
-            reduced_gravity: d.reduced_gravity,
-            mach_design: d.mach,
-            max_mach,
-            pressure_scale: (scenario.grains.density - f.density)
-                * column.packing_fraction
-                * gmag
-                * h_i,
-            acoustic_period_tc: t_a / tau_c,
-            pore_pressure_early_mean: mean_until(t_a),
-            pore_pressure_early_mean_2ta: mean_until(2.0 * t_a),
-            mlups: (nx * ny) as f64 * c.steps as f64 / wall_time_s.max(1e-9) / 1e6,
-        },
     };
-    write_json(&out_dir.join("summary.json"), &summary)?;
-    Ok(summary)
+    Ok((column, plan))
+}
+
+fn run_typed<T: Real>(
+    scenario: &SubmergedScenario,
+    d: &DerivedSubmerged,
+    out_dir: &Path,
+    progress: Progress,
+) -> Result<SubmergedSummary> {
+    let (column, plan) = column::<T>(scenario, d)?;
+    run_column(column, &plan, out_dir, progress)
 }

@@ -16,6 +16,10 @@
 //! ([`super::boundary`]). An even step touches only a node's own slots, so in even steps every
 //! fluid node but the Zou–He ones takes the vectorised loop. Links into obstacles are listed with their wall distance q so that
 //! [`super::obstacle`] can apply interpolated bounce-back and momentum exchange after the step.
+//!
+//! Length: the unsafe kernels (bulk, special and covered nodes, even and odd steps) share the
+//! private layout and rest on one safety argument (each slot is read and written by exactly
+//! one node per step); they stay in one file so that argument can be checked in one place.
 
 use rayon::prelude::*;
 

@@ -1,0 +1,453 @@
+//! The transfers of the explicit step ([`super`]): sorting and binning the points, point →
+//! grid (mass, momentum, forces; APIC or FLIP/PIC), the grid update with its walls, and the
+//! point passes grid → point (velocity, position, strain increment and stress update).
+
+use rayon::prelude::*;
+
+use super::*;
+
+impl Mpm {
+    /// Re-sort the points into cell order (x-major, as the nodes).
+    pub(super) fn resort(&mut self) {
+        let g = &self.grid;
+        let key = |p: [f64; 2]| -> usize {
+            let cx = ((p[0] - g.origin[0]) / g.h)
+                .floor()
+                .clamp(0.0, (g.nx - 1) as f64) as usize;
+            let cy = ((p[1] - g.origin[1]) / g.h)
+                .floor()
+                .clamp(0.0, (g.ny - 1) as f64) as usize;
+            cx * g.ny + cy
+        };
+        let ncells = g.nx * g.ny;
+        let mut count = vec![0usize; ncells + 1];
+        for &p in &self.points.pos {
+            count[key(p) + 1] += 1;
+        }
+        for c in 0..ncells {
+            count[c + 1] += count[c];
+        }
+        self.perm.clear();
+        self.perm.resize(self.points.len(), 0);
+        for (k, &p) in self.points.pos.iter().enumerate() {
+            let c = key(p);
+            self.perm[count[c]] = k as u32;
+            count[c] += 1;
+        }
+        let perm = std::mem::take(&mut self.perm);
+        self.points.permute(&perm, &mut self.scratch);
+        if !self.tractions.is_empty() {
+            // Old index perm[k] is now k.
+            self.inverse.resize(perm.len(), 0);
+            for (k, &old) in perm.iter().enumerate() {
+                self.inverse[old as usize] = k as u32;
+            }
+            for t in &mut self.tractions {
+                t.point = self.inverse[t.point as usize];
+            }
+        }
+        self.perm = perm;
+    }
+
+    /// Bin the points into stripes by the node column where their stencil starts; checks that
+    /// every point is finite and its stencil inside the grid.
+    pub(super) fn bin(&mut self) -> Result<()> {
+        let g = &self.grid;
+        let shape = self.params.shape;
+        let ns = self.stripe_start.len() - 1;
+        self.stripe_start.iter_mut().for_each(|c| *c = 0);
+        let (origin, h) = (g.origin, g.h);
+        self.stencils
+            .par_iter_mut()
+            .zip(self.points.pos.par_iter())
+            .zip(self.points.half_size.par_iter())
+            .for_each(|((st, &x), &lp)| *st = stencil(shape, origin, h, x, lp));
+        for (p, (&x, st)) in self.points.pos.iter().zip(&self.stencils).enumerate() {
+            let ok = x[0].is_finite()
+                && x[1].is_finite()
+                && st.i0 >= 0
+                && st.j0 >= 0
+                && st.i0 + 2 <= g.nx as i64
+                && st.j0 + 2 <= g.ny as i64;
+            if !ok {
+                let c = [
+                    ((x[0] - g.origin[0]) / g.h).max(0.0) as usize,
+                    ((x[1] - g.origin[1]) / g.h).max(0.0) as usize,
+                ];
+                return Err(Error::Unstable {
+                    step: self.steps,
+                    time: self.time,
+                    x: c[0],
+                    y: c[1],
+                    reason: format!(
+                        "material point {p} at ({:e}, {:e}) m is not finite or left the grid",
+                        x[0], x[1]
+                    ),
+                });
+            }
+            let s = st.i0 as usize / STRIPE;
+            self.stripe_of[p] = s as u32;
+            self.stripe_start[s + 1] += 1;
+        }
+        for s in 0..ns {
+            self.stripe_start[s + 1] += self.stripe_start[s];
+        }
+        for t in &self.tractions {
+            let (_, st) = self.traction_force(t);
+            if st.i0 < 0 || st.j0 < 0 || st.i0 + 2 > g.nx as i64 || st.j0 + 2 > g.ny as i64 {
+                return Err(Error::Unstable {
+                    step: self.steps,
+                    time: self.time,
+                    x: st.i0.max(0) as usize,
+                    y: st.j0.max(0) as usize,
+                    reason: format!("the traction face of point {} left the grid", t.point),
+                });
+            }
+        }
+        // Stable scatter: within a stripe the points keep their (cell) order.
+        let mut fill = std::mem::take(&mut self.perm);
+        fill.clear();
+        fill.extend(self.stripe_start[..ns].iter().map(|&v| v as u32));
+        for p in 0..self.points.len() {
+            let s = self.stripe_of[p] as usize;
+            self.order[fill[s] as usize] = p as u32;
+            fill[s] += 1;
+        }
+        self.perm = fill;
+        Ok(())
+    }
+
+    /// Scatter point quantities to the nodes. `mass`: mass and momentum; `force`: internal and
+    /// gravity force; `momentum`: momentum only (MUSL re-map; mass kept).
+    // The stencil loops index several 3-arrays (weights, gradients, offsets) by node.
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    pub(super) fn p2g(&mut self, mass: bool, force: bool, momentum: bool) {
+        // The transfer is a const parameter so the FLIP path carries no APIC branches.
+        if self.transfer == Transfer::Apic && (mass || momentum) {
+            self.p2g_with::<true>(mass, force, momentum)
+        } else {
+            self.p2g_with::<false>(mass, force, momentum)
+        }
+    }
+
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    pub(super) fn p2g_with<const APIC: bool>(&mut self, mass: bool, force: bool, momentum: bool) {
+        let g = &mut self.grid;
+        let nny = g.ny + 1;
+        let pts = &self.points;
+        let grav = self.params.gravity;
+        let (order, starts) = (&self.order, &self.stripe_start);
+        let stencils = &self.stencils;
+        let ns = starts.len() - 1;
+        let apic = APIC;
+        let (origin, h) = (g.origin, g.h);
+        g.sums.par_iter_mut().for_each(|s| {
+            if mass {
+                s[0] = 0.0;
+            }
+            if mass || momentum {
+                s[1] = 0.0;
+                s[2] = 0.0;
+            }
+            if force {
+                s[3] = 0.0;
+                s[4] = 0.0;
+            }
+        });
+        let chunk_len = 2 * STRIPE * nny;
+        for phase in 0..2 {
+            let head = (phase * STRIPE * nny).min(g.sums.len());
+            g.sums[head..]
+                .par_chunks_mut(chunk_len)
+                .enumerate()
+                .for_each(|(k, chunk): (usize, &mut [NodeSums])| {
+                    let s = 2 * k + phase;
+                    if s >= ns {
+                        return;
+                    }
+                    let col0 = (s * STRIPE) as i64;
+                    for &q in &order[starts[s]..starts[s + 1]] {
+                        let q = q as usize;
+                        let st = &stencils[q];
+                        let m = pts.mass[q];
+                        let v = pts.vel[q];
+                        let vol = pts.vol[q];
+                        let sg = pts.stress[q];
+                        // APIC: C = B D⁻¹ with D = diag(Σ w_x d_x², Σ w_y d_y²) here.
+                        let (mut c, mut dx, mut dy) = ([0.0; 4], [0.0; 3], [0.0; 3]);
+                        if apic {
+                            let x = pts.pos[q];
+                            let (mut ddx, mut ddy) = (0.0, 0.0);
+                            for k in 0..3 {
+                                dx[k] = origin[0] + (st.i0 + k as i64) as f64 * h - x[0];
+                                dy[k] = origin[1] + (st.j0 + k as i64) as f64 * h - x[1];
+                                ddx += st.wx[k] * dx[k] * dx[k];
+                                ddy += st.wy[k] * dy[k] * dy[k];
+                            }
+                            let bm = pts.affine[q];
+                            c = [bm[0] / ddx, bm[1] / ddy, bm[2] / ddx, bm[3] / ddy];
+                        }
+                        for a in 0..3 {
+                            let base = (st.i0 + a as i64 - col0) as usize * nny + st.j0 as usize;
+                            for b in 0..3 {
+                                let w = st.wx[a] * st.wy[b];
+                                let node = &mut chunk[base + b];
+                                if mass {
+                                    node[0] += w * m;
+                                }
+                                if apic {
+                                    let u = [
+                                        v[0] + c[0] * dx[a] + c[1] * dy[b],
+                                        v[1] + c[2] * dx[a] + c[3] * dy[b],
+                                    ];
+                                    node[1] += w * m * u[0];
+                                    node[2] += w * m * u[1];
+                                } else if mass || momentum {
+                                    node[1] += w * m * v[0];
+                                    node[2] += w * m * v[1];
+                                }
+                                if force {
+                                    let gx = st.gx[a] * st.wy[b];
+                                    let gy = st.wx[a] * st.gy[b];
+                                    node[3] += -vol * (sg[0] * gx + sg[2] * gy) + w * m * grav[0];
+                                    node[4] += -vol * (sg[2] * gx + sg[1] * gy) + w * m * grav[1];
+                                }
+                            }
+                        }
+                    }
+                });
+        }
+    }
+
+    /// Grid velocities from momenta: `vel` = p/m (unconstrained; the FLIP reference) and, when
+    /// `into_map`, `vel_map` = p/m with the walls applied (energy not booked: the momentum is
+    /// not changed). With `remap` (MUSL, after the momentum update) the walls keep the contact
+    /// state that the update gave each node ([`Grid::constrain_remap`]): the re-mapped field
+    /// stands for the same v^{n+1}, so a node that the update held on a unilateral wall is
+    /// held there, not released because the re-mapped FLIP velocities point away from it.
+    pub(super) fn grid_velocity(&mut self, into_map: bool, remap: bool) {
+        let g = &mut self.grid;
+        let eps = self.mass_eps;
+        let walls = &g.walls;
+        let contact = &g.contact;
+        let target = if into_map { &mut g.vel_map } else { &mut g.vel };
+        target
+            .par_iter_mut()
+            .zip(g.sums.par_iter())
+            .zip(g.walls_mask.par_iter())
+            .zip(contact.par_iter())
+            .for_each(|(((v, s), &mask), &engaged)| {
+                if s[0] > eps {
+                    *v = [s[1] / s[0], s[2] / s[0]];
+                    if into_map && remap {
+                        Grid::constrain_remap(walls, mask, engaged, v);
+                    } else if into_map {
+                        Grid::constrain(walls, mask, v);
+                    }
+                } else {
+                    *v = [0.0; 2];
+                }
+            });
+    }
+
+    /// v^{n+1} = v + Δt f/m (with local damping), then the walls; books the energy removed.
+    pub(super) fn grid_update(&mut self) {
+        let g = &mut self.grid;
+        let (eps, dt, alpha) = (self.mass_eps, self.dt, self.params.damping);
+        let walls = &g.walls;
+        let e = g
+            .vel_new
+            .par_iter_mut()
+            .zip(g.vel.par_iter())
+            .zip(g.sums.par_iter())
+            .zip(g.walls_mask.par_iter())
+            .zip(g.contact.par_iter_mut())
+            .map(|((((vn, v), s), &mask), engaged)| {
+                if s[0] <= eps {
+                    *vn = [0.0; 2];
+                    *engaged = 0;
+                    return [0.0; 3];
+                }
+                let mut f = [s[3], s[4]];
+                let mut damp = 0.0;
+                if alpha > 0.0 {
+                    for c in 0..2 {
+                        let fd = alpha * f[c].abs() * v[c].signum();
+                        f[c] -= fd;
+                        damp += fd * v[c] * dt;
+                    }
+                }
+                *vn = [v[0] + dt * f[0] / s[0], v[1] + dt * f[1] / s[0]];
+                let (dn, dtan, on) = Grid::constrain_tracked(walls, mask, vn);
+                *engaged = on;
+                // Work of the wall impulse m Δv at the midpoint velocity (v^{n+1} + v^n)/2.
+                let mid = [0.5 * (vn[0] + v[0]), 0.5 * (vn[1] + v[1])];
+                let en = -s[0] * (dn[0] * mid[0] + dn[1] * mid[1]);
+                let et = -s[0] * (dtan[0] * mid[0] + dtan[1] * mid[1]);
+                [en, et, damp]
+            })
+            .reduce(|| [0.0; 3], |a, b| [a[0] + b[0], a[1] + b[1], a[2] + b[2]]);
+        for (b, v) in self.booked.iter_mut().zip(e) {
+            *b += v;
+        }
+    }
+
+    /// One loop over the points (parallel in chunks), see [`PointPass`].
+    #[inline(always)]
+    pub(super) fn point_pass(&mut self, pass: PointPass) -> Result<()> {
+        // The transfer is a const parameter so the FLIP path carries no APIC branches.
+        if self.transfer == Transfer::Apic {
+            self.point_pass_with::<true>(pass)
+        } else {
+            self.point_pass_with::<false>(pass)
+        }
+    }
+
+    #[inline(always)]
+    pub(super) fn point_pass_with<const APIC: bool>(&mut self, pass: PointPass) -> Result<()> {
+        let g = &self.grid;
+        let (h, origin, nny) = (g.h, g.origin, g.ny + 1);
+        let (vold, vnew) = (&g.vel, &g.vel_new);
+        let vstrain = match pass {
+            PointPass::All => &g.vel_new,
+            _ => &g.vel_map,
+        };
+        let dt = self.dt;
+        let pic = self.params.pic_fraction;
+        let apic = APIC;
+        let mat = &self.material;
+        let do_v = matches!(
+            pass,
+            PointPass::Velocity | PointPass::All | PointPass::VelocityAndMove
+        );
+        let do_x = matches!(
+            pass,
+            PointPass::All | PointPass::StressFromMapAndMove | PointPass::VelocityAndMove
+        );
+        let do_s = matches!(
+            pass,
+            PointPass::All | PointPass::StressFromMap | PointPass::StressFromMapAndMove
+        );
+        let stencils = &self.stencils;
+        let p = &mut self.points;
+        let bad = (
+            p.pos.par_chunks_mut(CHUNK),
+            p.vel.par_chunks_mut(CHUNK),
+            p.def_grad.par_chunks_mut(CHUNK),
+            p.vol.par_chunks_mut(CHUNK),
+            p.stress.par_chunks_mut(CHUNK),
+            p.state.par_chunks_mut(CHUNK),
+            p.work.par_chunks_mut(CHUNK),
+            p.vol0.par_chunks(CHUNK),
+            stencils.par_chunks(CHUNK),
+            p.affine.par_chunks_mut(CHUNK),
+        )
+            .into_par_iter()
+            .enumerate()
+            .map(
+                |(k, (pos, vel, fg, vol, sig, state, work, vol0, sts, aff))| {
+                    let mut bad = None;
+                    for q in 0..pos.len() {
+                        let st = &sts[q];
+                        let mut dv = [0.0; 2];
+                        let mut xn = [0.0; 2];
+                        let mut l = [0.0; 4];
+                        let mut bm = [0.0; 4];
+                        for a in 0..3 {
+                            let base = (st.i0 + a as i64) as usize * nny + st.j0 as usize;
+                            for b in 0..3 {
+                                let n = base + b;
+                                let w = st.wx[a] * st.wy[b];
+                                if do_v {
+                                    dv[0] += w * (vnew[n][0] - vold[n][0]);
+                                    dv[1] += w * (vnew[n][1] - vold[n][1]);
+                                }
+                                if do_x || pic > 0.0 || apic {
+                                    xn[0] += w * vnew[n][0];
+                                    xn[1] += w * vnew[n][1];
+                                }
+                                if apic && do_v {
+                                    let d = [
+                                        origin[0] + (st.i0 + a as i64) as f64 * h - pos[q][0],
+                                        origin[1] + (st.j0 + b as i64) as f64 * h - pos[q][1],
+                                    ];
+                                    let u = vnew[n];
+                                    bm[0] += w * u[0] * d[0];
+                                    bm[1] += w * u[0] * d[1];
+                                    bm[2] += w * u[1] * d[0];
+                                    bm[3] += w * u[1] * d[1];
+                                }
+                                if do_s {
+                                    let gx = st.gx[a] * st.wy[b];
+                                    let gy = st.wx[a] * st.gy[b];
+                                    let v = vstrain[n];
+                                    l[0] += v[0] * gx;
+                                    l[1] += v[0] * gy;
+                                    l[2] += v[1] * gx;
+                                    l[3] += v[1] * gy;
+                                }
+                            }
+                        }
+                        if do_v && apic {
+                            vel[q] = xn;
+                            aff[q] = bm;
+                        } else if do_v {
+                            // FLIP increment, blended with the PIC velocity Σ N v^{n+1}.
+                            vel[q][0] = (1.0 - pic) * (vel[q][0] + dv[0]) + pic * xn[0];
+                            vel[q][1] = (1.0 - pic) * (vel[q][1] + dv[1]) + pic * xn[1];
+                        }
+                        if do_s {
+                            let f = fg[q];
+                            let a = [1.0 + dt * l[0], dt * l[1], dt * l[2], 1.0 + dt * l[3]];
+                            let fnew = [
+                                a[0] * f[0] + a[1] * f[2],
+                                a[0] * f[1] + a[1] * f[3],
+                                a[2] * f[0] + a[3] * f[2],
+                                a[2] * f[1] + a[3] * f[3],
+                            ];
+                            let j = fnew[0] * fnew[3] - fnew[1] * fnew[2];
+                            if (j.is_nan() || j <= 0.0) && bad.is_none() {
+                                bad = Some((k * CHUNK + q, format!("det F = {j:e} ≤ 0")));
+                            }
+                            fg[q] = fnew;
+                            let vnew_ = j * vol0[q];
+                            let de = [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])];
+                            let spin = 0.5 * dt * (l[1] - l[2]);
+                            let s0 = sig[q];
+                            let s1 = mat.update_stress(&s0, &de, spin, dt, &mut state[q]);
+                            let smid = [
+                                0.5 * (s0[0] + s1[0]),
+                                0.5 * (s0[1] + s1[1]),
+                                0.5 * (s0[2] + s1[2]),
+                            ];
+                            work[q] += 0.5
+                                * (vol[q] + vnew_)
+                                * (smid[0] * de[0] + smid[1] * de[1] + 2.0 * smid[2] * de[2]);
+                            sig[q] = s1;
+                            vol[q] = vnew_;
+                        }
+                        if do_x {
+                            pos[q][0] += dt * xn[0];
+                            pos[q][1] += dt * xn[1];
+                        }
+                    }
+                    bad
+                },
+            )
+            .find_any(|b| b.is_some())
+            .flatten();
+        if let Some((q, why)) = bad {
+            let x = self.points.pos[q];
+            return Err(Error::Unstable {
+                step: self.steps,
+                time: self.time,
+                x: ((x[0] - origin[0]) / h).max(0.0) as usize,
+                y: ((x[1] - origin[1]) / h).max(0.0) as usize,
+                reason: format!("material point {q}: {why}"),
+            });
+        }
+        Ok(())
+    }
+}

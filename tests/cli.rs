@@ -281,3 +281,83 @@ fn biaxial_refuses_bad_options() {
         assert!(!out_dir.exists());
     }
 }
+
+/// A scenario file is read as the kind it declares (issue 19): a misspelt key in a DEM file gets
+/// the DEM parser's error, not the fluid's; a file without `kind` is refused with the line to
+/// add; a file of another kind than the command needs is refused naming both.
+#[test]
+fn the_declared_kind_decides_the_parser() {
+    let dir = tempfile::tempdir().unwrap();
+    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+    let fails = |args: &[&std::ffi::OsStr], expect: &[&str], absent: &[&str]| {
+        let out = granflow().args(args).output().unwrap();
+        assert!(!out.status.success(), "{args:?} succeeded");
+        let err = String::from_utf8_lossy(&out.stderr);
+        for e in expect {
+            assert!(err.contains(e), "expected `{e}` in: {err}");
+        }
+        for a in absent {
+            assert!(!err.contains(a), "unexpected `{a}` in: {err}");
+        }
+    };
+    let write = |name: &str, text: String| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let dem = std::fs::read_to_string(models.join("column_collapse/dem_a2.toml")).unwrap();
+    let typo = write(
+        "typo.toml",
+        dem.replacen("friction = 0.53", "fricton = 0.53", 1),
+    );
+    // The DEM contact table's own fields are listed; nothing of the fluid file's.
+    fails(
+        &["check".as_ref(), typo.as_os_str()],
+        &["fricton", "rolling_friction"],
+        &["domain", "boundaries"],
+    );
+    let bare = write("bare.toml", dem.replacen("kind = \"dem\"\n", "", 1));
+    fails(
+        &["check".as_ref(), bare.as_os_str()],
+        &["kind", "missing", "kind = \"dem\""],
+        &[],
+    );
+    let wrong = write(
+        "wrong.toml",
+        dem.replacen("kind = \"dem\"", "kind = \"dme\"", 1),
+    );
+    fails(
+        &[
+            "run".as_ref(),
+            wrong.as_os_str(),
+            "--out".as_ref(),
+            dir.path().join("o").as_os_str(),
+        ],
+        &["kind", "must be one of", "dme"],
+        &[],
+    );
+    let sweep = models.join("column_collapse/sweep_quick.toml");
+    fails(
+        &[
+            "run".as_ref(),
+            sweep.as_os_str(),
+            "--out".as_ref(),
+            dir.path().join("s").as_os_str(),
+        ],
+        &["sweep file", "granflow sweep"],
+        &[],
+    );
+    fails(
+        &[
+            "biaxial".as_ref(),
+            data("tiny_channel.toml").as_os_str(),
+            "--confining".as_ref(),
+            "1000".as_ref(),
+            "--out".as_ref(),
+            dir.path().join("b").as_os_str(),
+        ],
+        &["`fluid` file", "`dem` file"],
+        &[],
+    );
+    assert!(!dir.path().join("o").exists() && !dir.path().join("s").exists());
+}

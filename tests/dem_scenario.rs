@@ -50,6 +50,7 @@ fn model_files_parse_and_check() {
 fn tiny() -> String {
     // 2-D units scaled for a test: 5 mm grains, soft contacts; ≈ 60 grains.
     r#"
+kind = "dem"
 name = "tiny"
 description = "test"
 gravity = 9.81

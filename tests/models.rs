@@ -1,9 +1,13 @@
-//! Every scenario under `models/` parses and passes `derive()` (the `check` command).
+//! Every scenario under `models/` declares its kind, parses as that kind and passes
+//! `derive()` (the `check` command).
 
 use std::path::Path;
 
+use granflow::scenario::dem::DemScenario;
 use granflow::scenario::fluid::Scenario;
-use granflow::scenario::ScenarioFile;
+use granflow::scenario::mpm::MpmScenario;
+use granflow::scenario::submerged::SubmergedScenario;
+use granflow::scenario::{kind_of_file, Kind, ScenarioFile};
 
 fn toml_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
     for e in std::fs::read_dir(dir).unwrap() {
@@ -29,4 +33,40 @@ fn every_model_file_parses_and_checks() {
         s.derive()
             .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
     }
+}
+
+#[test]
+fn every_model_file_declares_its_kind_and_checks_as_it() {
+    let mut files = Vec::new();
+    toml_files(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("models"),
+        &mut files,
+    );
+    let mut seen = std::collections::BTreeSet::new();
+    for f in &files {
+        let kind = kind_of_file(f).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        seen.insert(kind.name());
+        let checked = match kind {
+            Kind::Fluid => Scenario::from_file(f).and_then(|s| s.derive()).map(|_| ()),
+            Kind::Dem => DemScenario::from_file(f)
+                .and_then(|s| s.derive())
+                .map(|_| ()),
+            Kind::Mpm => MpmScenario::from_file(f)
+                .and_then(|s| s.derive())
+                .map(|_| ()),
+            Kind::Submerged => SubmergedScenario::from_file(f)
+                .and_then(|s| s.derive())
+                .map(|_| ()),
+            // Expanding a sweep reads its bases; each case is checked when it runs.
+            Kind::Sweep => granflow::sweep::read_sweep(f).map(|_| ()),
+        };
+        if let Err(e) = checked {
+            panic!("{}: {e}", f.display());
+        }
+    }
+    assert_eq!(
+        seen.len(),
+        Kind::ALL.len(),
+        "every kind has a model file: {seen:?}"
+    );
 }

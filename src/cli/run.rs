@@ -111,13 +111,10 @@ fn check_dem(path: &Path) -> Result<ExitCode> {
         s.column.width, d.target_height
     );
     println!("tau_c (target)  {:.4e} s", d.target_tau_c);
-    match d.params.dt {
-        Some(dt) => println!("dt              {dt:.4e} s (given)"),
-        None => println!(
-            "dt              λ·Δt_cr with λ = {} (computed from the smallest grain)",
-            d.params.lambda
-        ),
-    }
+    println!(
+        "dt              {:.4e} s (λ·Δt_cr, λ = {}, Δt_cr = {:.4e} s for d_min; the drawn grains may allow more)",
+        d.time_step.dt, d.params.lambda, d.time_step.critical
+    );
     println!("ok");
     Ok(ExitCode::SUCCESS)
 }

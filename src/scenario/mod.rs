@@ -234,15 +234,9 @@ pub(crate) fn non_negative(field: &str, v: f64) -> Result<()> {
 
 /// Parse TOML text into a scenario type; the error carries the parser's message, which names
 /// the line and the key (unknown, missing or mistyped).
-pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T> {
+fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T> {
     toml::from_str(text).map_err(|e| Error::Parse {
         path: "<text>".into(),
         message: e.to_string(),
     })
-}
-
-/// Read and parse a TOML file (see [`parse_toml`]); errors name the file.
-pub fn read_toml<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    parse_toml(&text).map_err(|e| in_file(e, path))
 }

@@ -185,7 +185,6 @@ impl ShearSpec {
             ("shear.pressure", self.pressure),
             ("shear.inertial_number", self.inertial_number),
             ("shear.strain", self.strain),
-            ("shear.lambda", self.lambda),
             ("shear.density", self.density),
             ("shear.thickness", self.thickness),
         ] {

@@ -2,7 +2,7 @@
 //!
 //! * [`run`]: `check` and `run` of a scenario file of any kind (dispatched on its `kind`);
 //! * [`study`]: `validate`, `sweep`, `biaxial`, `shear`;
-//! * [`bench`]: `bench`.
+//! * [`bench`]: the `bench` command.
 
 pub mod bench;
 pub mod run;

@@ -57,7 +57,7 @@ impl TimeStep {
     }
 
     /// The step for `grains` (polygons enter with the effective mass of their contact points,
-    /// [`polygon_contact_mass`]).
+    /// `polygon_contact_mass`).
     pub fn of_grains(params: &DemParams, grains: &Grains) -> Result<Self> {
         TimeStep::new(
             params,

@@ -2,8 +2,8 @@
 //! published table or a conservation law, and reports one [`Check`] per quantity.
 //!
 //! `granflow validate <case|all> [--json] [--figures DIR]` prints them (and writes each case's
-//! [`Plot`]s as SVG); the tests under `tests/` run the same cases at [`Fidelity::Test`] (the
-//! smallest resolution that still proves the claim).
+//! [`Plot`](crate::report::Plot)s as SVG); the tests under `tests/` run the same cases at
+//! [`Fidelity::Test`] (the smallest resolution that still proves the claim).
 
 use super::dem::{validation as dem, validation_polygon};
 use super::fluid::validation::{cavity, conservation, cylinder, les, poiseuille, taylor_green};

@@ -4,7 +4,7 @@
 //! * [`spec`]: the file's schema and its checks ([`DemScenario`]);
 //! * [`biaxial`]: `granflow biaxial`, the material's peak and critical-state friction angles;
 //! * [`shear`]: `granflow shear`, its μ(I) by periodic simple shear;
-//! * [`bench`]: `granflow bench dem` (the LAMMPS `in.gran2d.lmp` case);
+//! * [`bench`](mod@bench): `granflow bench dem` (the LAMMPS `in.gran2d.lmp` case);
 //! * [`validation`], [`validation_polygon`]: the DEM validation cases.
 //!
 //! The collapse itself runs in [`super::collapse`].

@@ -3,7 +3,7 @@
 //!
 //! * [`spec`]: the file's schema, its checks and the derived lattice quantities;
 //! * [`run`]: the runner (`granflow run`: VTK frames, time series, summary);
-//! * [`bench`]: `granflow bench lbm`;
+//! * [`bench`](mod@bench): `granflow bench lbm`;
 //! * [`validation`]: the LBM validation cases.
 
 pub mod bench;

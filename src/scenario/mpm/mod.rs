@@ -1,7 +1,7 @@
 //! MPM scenarios (`kind = "mpm"`): the GIMPM column collapse.
 //!
 //! * [`spec`]: the file's schema and its checks ([`MpmScenario`]);
-//! * [`bench`]: `granflow bench mpm`;
+//! * [`bench`](mod@bench): `granflow bench mpm`;
 //! * [`validation`]: the MPM validation cases.
 //!
 //! The collapse itself runs in [`super::collapse`].

@@ -2,7 +2,7 @@
 //! liquid.
 //!
 //! * [`spec`]: the file's schema and its checks ([`SubmergedScenario`]);
-//! * [`bench`]: `granflow bench coupled` (seed Table 5.3 size);
+//! * [`bench`](mod@bench): `granflow bench coupled` (seed Table 5.3 size);
 //! * [`validation`], [`validation_ladd`]: the coupling validation cases (partially saturated
 //!   cells, Ladd's bounce-back).
 //!

@@ -5,6 +5,7 @@
 //! * [`contact`]: the contact law (linear spring-dashpot normal force with the damping set by a
 //!   restitution coefficient, tangential spring with history and Coulomb cap, rolling
 //!   resistance) and the critical step of one spring;
+//! * [`params`]: the parameters of a system (contact laws, gravity, step rule, skin);
 //! * [`time_step`]: the DEM time step Δt_D = λ Δt_cr, derived in one place;
 //! * [`walls`]: half-planes and line segments;
 //! * [`neighbours`]: uniform-grid cell list and Verlet neighbour list with contact history
@@ -24,6 +25,7 @@ pub mod energy;
 pub mod grains;
 pub mod neighbours;
 pub mod packing;
+pub mod params;
 pub mod scale;
 pub mod shape;
 pub mod shape_contacts;
@@ -36,6 +38,7 @@ pub mod walls;
 pub use contact::{damping_ratio, restitution_of, ContactParams};
 pub use energy::Energy;
 pub use grains::Grains;
-pub use solver::{Dem, DemParams, ExternalLoads, Overlap, OVERLAP_LIMIT};
+pub use params::DemParams;
+pub use solver::{Dem, ExternalLoads, Overlap, OVERLAP_LIMIT};
 pub use time_step::{critical_step, TimeStep};
 pub use walls::Wall;

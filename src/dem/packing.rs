@@ -4,7 +4,8 @@
 
 use super::contact::ContactParams;
 use super::grains::Grains;
-use super::solver::{Dem, DemParams};
+use super::params::DemParams;
+use super::solver::Dem;
 use super::walls::Wall;
 use crate::{Error, Result};
 

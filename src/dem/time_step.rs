@@ -5,7 +5,7 @@
 
 use super::contact;
 use super::grains::Grains;
-use super::solver::DemParams;
+use super::params::DemParams;
 use crate::{Error, Result};
 
 /// The DEM step: Δt_cr and the step in use.

@@ -34,11 +34,12 @@
 
 use rayon::prelude::*;
 
-use super::contact::{ContactOut, ContactParams, ContactState, Event, Law, Motion};
+use super::contact::{ContactOut, ContactState, Event, Law, Motion};
 use super::detect_rapier::RapierDetector;
 use super::energy::Energy;
 use super::grains::Grains;
 use super::neighbours::{Detector, PairList, WallList, PAIR_TOUCHING};
+use super::params::DemParams;
 use super::shape_contacts::{ShapeContacts, ShapeSums};
 use super::time_step::TimeStep;
 use super::walls::Wall;
@@ -52,41 +53,6 @@ use forces::{chunks, Drift, JForce};
 /// the pairs and wall pairs of its grains). Fixed, so that the order in which a grain's forces
 /// are summed does not depend on the thread count.
 const GRAIN_CHUNK: usize = 1024;
-
-/// Parameters of a DEM system, SI.
-#[derive(Clone, Debug, PartialEq)]
-pub struct DemParams {
-    /// Grain–grain contact law.
-    pub grain: ContactParams,
-    /// Grain–wall contact law.
-    pub wall: ContactParams,
-    /// Gravitational acceleration **g** (m/s²).
-    pub gravity: [f64; 2],
-    /// Time step; `None` takes λ Δt_cr. A value above λ Δt_cr is refused.
-    pub dt: Option<f64>,
-    /// Safety factor λ of seed eq. 5.60 (0.1 in the seed).
-    pub lambda: f64,
-    /// Verlet skin as a fraction of the largest grain diameter (e.g. 0.2).
-    pub skin_fraction: f64,
-    /// Global damping rate α (1/s) of seed eq. 5.57, c = α m; 0 = off (the default).
-    pub global_damping: f64,
-}
-
-impl DemParams {
-    /// Parameters with `grain` and `wall` laws, gravity, automatic step, λ = 0.1, skin 0.2 d_max,
-    /// no global damping.
-    pub fn new(grain: ContactParams, wall: ContactParams, gravity: [f64; 2]) -> Self {
-        DemParams {
-            grain,
-            wall,
-            gravity,
-            dt: None,
-            lambda: 0.1,
-            skin_fraction: 0.2,
-            global_damping: 0.0,
-        }
-    }
-}
 
 /// External loads held during [`Dem::advance_with`] (e.g. hydrodynamic force and torque from
 /// the fluid, seed eq. 5.53–5.54). Empty vectors mean none.

@@ -17,8 +17,8 @@ use serde::Serialize;
 
 use crate::dem::contact::ContactParams;
 use crate::dem::packing::{hex_block, SizeDistribution};
-use crate::dem::solver::{Dem, DemParams};
 use crate::dem::walls::Wall;
+use crate::dem::{Dem, DemParams};
 use crate::{Error, Result};
 
 /// Warm-up steps before timing (as `peers/lammps.sh`: `-var warm 500`).

@@ -32,8 +32,8 @@ use serde::Serialize;
 
 use crate::dem::contact::ContactParams;
 use crate::dem::packing::{deposit_column, with_friction, ColumnSpec};
-use crate::dem::solver::{Dem, DemParams};
 use crate::dem::walls::Wall;
+use crate::dem::{Dem, DemParams};
 use crate::io::csv::CsvWriter;
 use crate::io::json::write_json;
 use crate::io::plot::write_svg;

@@ -11,8 +11,8 @@
 use crate::dem::contact::ContactParams;
 use crate::dem::grains::Grains;
 use crate::dem::packing::SplitMix64;
-use crate::dem::solver::{Dem, DemParams};
 use crate::dem::walls::Wall;
+use crate::dem::{Dem, DemParams};
 use crate::report::{Check, Fidelity};
 use crate::Result;
 

@@ -17,8 +17,8 @@ use crate::dem::detect_rapier::{cell_list_contacts, Contact, Coverage, RapierDet
 use crate::dem::grains::Grains;
 use crate::dem::packing::SplitMix64;
 use crate::dem::shape::Polygons;
-use crate::dem::solver::{Dem, DemParams};
 use crate::dem::walls::Wall;
+use crate::dem::{Dem, DemParams};
 use crate::report::{Check, Fidelity};
 use crate::Result;
 

@@ -38,7 +38,7 @@ use crate::dem::stress::grain_stress;
 use crate::dem::{Dem, Energy, Wall};
 use crate::exec::Progress;
 use crate::io::{write_vtu_points, Field, PvdSeries};
-use crate::scenario::dem::spec::DemScenario;
+use crate::scenario::dem::spec::{DemScenario, DemTimeSpec};
 use crate::Result;
 
 /// Two grains belong to the same mass when their gap is below this fraction of R_i + R_j.
@@ -251,6 +251,42 @@ pub struct DemColumn {
     deposition_wall_time_s: f64,
 }
 
+/// The energies of a time-series row, in the order of the first seven [`COLUMNS`] (J).
+pub(super) fn energy_values(e: &Energy) -> [f64; 7] {
+    [
+        e.kinetic,
+        e.rotational,
+        e.potential,
+        e.elastic(),
+        e.dissipated_normal,
+        e.dissipated_friction,
+        e.dissipated_rolling,
+    ]
+}
+
+/// The plan of a DEM column (dry or submerged) of initial width `l_i`, deposited height `h_i`
+/// and initial potential energy `potential`, on the schedule of the scenario's `[time]`.
+pub(super) fn plan<'a>(
+    scenario_name: &'a str,
+    [l_i, h_i]: [f64; 2],
+    gravity: f64,
+    potential: f64,
+    ts: &DemTimeSpec,
+) -> Plan<'a> {
+    Plan {
+        name: scenario_name,
+        l_i,
+        h_i,
+        gravity,
+        potential,
+        series_interval_tc: ts.series_interval_tc,
+        frame_interval_tc: ts.frame_interval_tc,
+        end_tc: ts.end_tc,
+        rest_kinetic_fraction: ts.rest_kinetic_fraction,
+        rest_duration_tc: ts.rest_duration_tc,
+    }
+}
+
 /// The DEM's time-series columns after the geometry.
 const COLUMNS: &[&str] = &[
     "kinetic",
@@ -294,16 +330,10 @@ impl Column for DemColumn {
             front: s.front,
             height: s.height,
             kinetic: e.kinetic_total(),
-            values: vec![
-                e.kinetic,
-                e.rotational,
-                e.potential,
-                e.elastic(),
-                e.dissipated_normal,
-                e.dissipated_friction,
-                e.dissipated_rolling,
-                self.budget(&e),
-            ],
+            values: energy_values(&e)
+                .into_iter()
+                .chain([self.budget(&e)])
+                .collect(),
         };
         Ok((
             row,
@@ -361,18 +391,13 @@ pub fn column(scenario: &DemScenario) -> Result<(DemColumn, Plan<'_>)> {
     dem.refresh_forces();
     let e0 = dem.energy();
     let ts = &scenario.time;
-    let plan = Plan {
-        name: &scenario.name,
-        l_i: scenario.column.width,
-        h_i: deposit.height,
-        gravity: scenario.gravity,
-        potential: e0.potential,
-        series_interval_tc: ts.series_interval_tc,
-        frame_interval_tc: ts.frame_interval_tc,
-        end_tc: ts.end_tc,
-        rest_kinetic_fraction: ts.rest_kinetic_fraction,
-        rest_duration_tc: ts.rest_duration_tc,
-    };
+    let plan = plan(
+        &scenario.name,
+        [scenario.column.width, deposit.height],
+        scenario.gravity,
+        e0.potential,
+        ts,
+    );
     let series_steps = steps_per_row(ts.series_interval_tc, plan.tau_c(), dem.dt());
     let column = DemColumn {
         dem,

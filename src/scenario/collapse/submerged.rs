@@ -36,7 +36,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::dem::{shape, write_frame, Shape};
+use super::dem::{energy_values, plan, shape, write_frame, Shape};
 use super::{run_column, Column, Plan, Row, Tally};
 use crate::analysis::runout::CollapseOutcome;
 use crate::coupling::{
@@ -359,20 +359,16 @@ impl<T: Real> Column for SubmergedColumn<'_, T> {
             front: s.front,
             height: s.height,
             kinetic: e.kinetic_total(),
-            values: vec![
-                e.kinetic,
-                e.rotational,
-                e.potential,
-                e.elastic(),
-                e.dissipated_normal,
-                e.dissipated_friction,
-                e.dissipated_rolling,
-                p_base,
-                drag_x,
-                drag_y,
-                self.fields.kinetic(&u, self.scenario.grains.thickness),
-                mach,
-            ],
+            values: energy_values(&e)
+                .into_iter()
+                .chain([
+                    p_base,
+                    drag_x,
+                    drag_y,
+                    self.fields.kinetic(&u, self.scenario.grains.thickness),
+                    mach,
+                ])
+                .collect(),
         };
         Ok((row, s))
     }
@@ -551,18 +547,7 @@ pub fn column<'a, T: Real>(
         view: GrainView::default(),
         strip,
     };
-    let plan = Plan {
-        name: &scenario.name,
-        l_i,
-        h_i,
-        gravity: gmag,
-        potential: e0.potential,
-        series_interval_tc: ts.series_interval_tc,
-        frame_interval_tc: ts.frame_interval_tc,
-        end_tc: ts.end_tc,
-        rest_kinetic_fraction: ts.rest_kinetic_fraction,
-        rest_duration_tc: ts.rest_duration_tc,
-    };
+    let plan = plan(&scenario.name, [l_i, h_i], gmag, e0.potential, ts);
     let column = SubmergedColumn {
         scenario,
         derived: d,

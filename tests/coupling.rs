@@ -83,7 +83,6 @@ fn zero_weight_matches_plain<T: granflow::lbm::Real>(model: CollisionModel, les:
     for c in (0..nx * ny).step_by(2) {
         covered.partial.push(c as u32, 0.0, [0.05, -0.05]);
     }
-    covered.exchange.resize(covered.partial.len(), [0.0; 2]);
     for _ in 0..7 {
         plain.step();
         covered.step();

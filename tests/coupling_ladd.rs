@@ -52,14 +52,7 @@ fn ladd_force_noise() {
 #[test]
 fn ladd_f32_mrt_les_in_the_driver() {
     let (nx, ny) = (48, 40);
-    let wall = granflow::lbm::Edge::Wall { velocity: [0.0; 2] };
-    let edges = Edges {
-        left: wall.clone(),
-        right: wall.clone(),
-        bottom: wall.clone(),
-        top: wall,
-    };
-    let lat = Lattice::<f32>::new(nx, ny, edges, vec![false; nx * ny]).unwrap();
+    let lat = Lattice::<f32>::new(nx, ny, Edges::closed(), vec![false; nx * ny]).unwrap();
     let fluid = CoupledFluid::new(Lbm::new(
         lat,
         FluidModel {

@@ -222,16 +222,14 @@ pub fn run(path: &Path, out: &Path) -> Result<ExitCode> {
 }
 
 fn run_submerged(path: &Path, out: &Path) -> Result<ExitCode> {
-    {
-        let s = SubmergedScenario::from_file(path)?;
-        eprintln!("{}: submerged column collapse -> {}", s.name, out.display());
-        let r = with_progress((1e3 * s.time.end_tc) as u64, "milli-τ_c", |p| {
-            granflow::scenario::collapse::submerged::run_submerged(&s, out, p)
-        })
-        .with_context(|| stopped(path, out))?;
-        println!("{}", r.done_line());
-        Ok(ExitCode::SUCCESS)
-    }
+    let s = SubmergedScenario::from_file(path)?;
+    eprintln!("{}: submerged column collapse -> {}", s.name, out.display());
+    let r = with_progress((1e3 * s.time.end_tc) as u64, "milli-τ_c", |p| {
+        granflow::scenario::collapse::submerged::run_submerged(&s, out, p)
+    })
+    .with_context(|| stopped(path, out))?;
+    println!("{}", r.done_line());
+    Ok(ExitCode::SUCCESS)
 }
 
 fn run_fluid(path: &Path, out: &Path) -> Result<ExitCode> {

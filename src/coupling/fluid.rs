@@ -74,6 +74,8 @@ impl<T: Real> CoupledFluid<T> {
     /// One lattice step: covered cells collide as partially saturated cells, then Ladd's links
     /// bounce back.
     pub fn step(&mut self) {
+        // Cells pushed by hand since the last cover get an exchange entry too.
+        self.exchange.resize(self.partial.len(), [0.0; 2]);
         let links = &mut self.ladd;
         self.lbm
             .step_covered(&self.partial, &mut self.exchange, |lat, was_even| {

@@ -66,6 +66,17 @@ impl Edges {
         }
     }
 
+    /// Resting walls on all four edges (a closed box, e.g. a tank).
+    pub fn closed() -> Self {
+        let wall = Edge::Wall { velocity: [0.0; 2] };
+        Edges {
+            left: wall.clone(),
+            right: wall.clone(),
+            bottom: wall.clone(),
+            top: wall,
+        }
+    }
+
     /// Periodic in x, resting walls at the bottom and top (a channel).
     pub fn channel() -> Self {
         let wall = Edge::Wall { velocity: [0.0; 2] };

@@ -48,9 +48,7 @@ use crate::dem::scale::GrainView;
 use crate::dem::{Dem, Energy, ExternalLoads, Wall};
 use crate::exec::Progress;
 use crate::io::{write_vti, Field, ImageGrid, PvdSeries};
-use crate::lbm::{
-    Edge, Edges, Fluid, FluidModel, Lattice, Lbm, Macroscopic, Obstacles, Real, STOP_MACH,
-};
+use crate::lbm::{Edges, Fluid, FluidModel, Lattice, Lbm, Macroscopic, Obstacles, Real, STOP_MACH};
 use crate::scale::Scale;
 use crate::scenario::fluid::Precision;
 use crate::scenario::submerged::spec::{CouplingMethod, DerivedSubmerged, SubmergedScenario};
@@ -485,13 +483,7 @@ pub fn column<'a, T: Real>(
     let dem = Dem::new(deposit.grains, walls, params)?;
     let [nx, ny] = d.cells;
     let u = d.units;
-    let wall = Edge::Wall { velocity: [0.0; 2] };
-    let edges = Edges {
-        left: wall.clone(),
-        right: wall.clone(),
-        bottom: wall.clone(),
-        top: wall,
-    };
+    let edges = Edges::closed();
     let lattice = Lattice::<T>::new(nx, ny, edges, vec![false; nx * ny])
         .map_err(|e| Error::Other(format!("lattice: {e}")))?;
     let fluid = CoupledFluid::new(Lbm::new(

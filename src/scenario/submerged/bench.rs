@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use crate::coupling::{Coupled, CoupledFluid, DiskCover, Grid};
 use crate::dem::{ContactParams, Dem, DemParams, Grains};
-use crate::lbm::{CollisionModel, Edge, Edges, FluidModel, Lattice, Lbm, Obstacles, Real};
+use crate::lbm::{CollisionModel, Edges, FluidModel, Lattice, Lbm, Obstacles, Real};
 use crate::units::Units;
 use crate::{Error, Result};
 
@@ -45,14 +45,8 @@ pub struct CoupledBench {
 }
 
 fn time<T: Real>(nx: usize, ny: usize, n: usize, steps: u64) -> Result<CoupledBench> {
-    let wall = Edge::Wall { velocity: [0.0; 2] };
-    let edges = Edges {
-        left: Edge::Periodic,
-        right: Edge::Periodic,
-        bottom: wall.clone(),
-        top: wall,
-    };
-    let lat = Lattice::<T>::new(nx, ny, edges, vec![false; nx * ny]).map_err(Error::Other)?;
+    let lat =
+        Lattice::<T>::new(nx, ny, Edges::channel(), vec![false; nx * ny]).map_err(Error::Other)?;
     // SI: Δx = 0.1 mm, water, τ = 0.6.
     let (dx, nu, rho_f, rho_s) = (1e-4, 1e-6, 1000.0, 2650.0);
     let tau = 0.6;

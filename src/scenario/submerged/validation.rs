@@ -355,13 +355,7 @@ pub fn settling_disk_with<T: Real, M: Exchange<CoupledFluid<T>, Dem>>(
     let tau = 0.8;
     let nu = (tau - 0.5) / 3.0;
     let (nx, ny) = (4 * d, 16 * d);
-    let wall = crate::lbm::Edge::Wall { velocity: [0.0; 2] };
-    let edges = Edges {
-        left: wall.clone(),
-        right: wall.clone(),
-        bottom: wall.clone(),
-        top: wall,
-    };
+    let edges = Edges::closed();
     let lat = Lattice::<T>::new(nx, ny, edges, vec![false; nx * ny])
         .map_err(|e| Error::Other(format!("lattice: {e}")))?;
     let fluid = CoupledFluid::new(Lbm::new(
@@ -521,13 +515,7 @@ pub fn dkt_run(d_cells: usize, rho_p: f64, tau: f64, t_end: f64) -> Result<Dkt> 
     let dx = d / d_cells as f64;
     let (nx, ny) = ((w / dx).round() as usize, (h / dx).round() as usize);
     let units = Units::from_tau(dx, tau, nu, rho_f);
-    let wall = crate::lbm::Edge::Wall { velocity: [0.0; 2] };
-    let edges = Edges {
-        left: wall.clone(),
-        right: wall.clone(),
-        bottom: wall.clone(),
-        top: wall,
-    };
+    let edges = Edges::closed();
     let lat = Lattice::<f64>::new(nx, ny, edges, vec![false; nx * ny])
         .map_err(|e| Error::Other(format!("lattice: {e}")))?;
     let fluid = CoupledFluid::new(Lbm::new(

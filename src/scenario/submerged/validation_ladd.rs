@@ -353,16 +353,10 @@ pub fn towed_disk_force<M>(
 where
     M: TowMap,
 {
-    use crate::lbm::{Edge, Edges, Lattice, Obstacles};
+    use crate::lbm::{Edges, Lattice, Obstacles};
     use crate::scale::Scale;
     let (nx, ny) = (16 * d, 4 * d);
-    let wall = Edge::Wall { velocity: [0.0; 2] };
-    let edges = Edges {
-        left: wall.clone(),
-        right: wall.clone(),
-        bottom: wall.clone(),
-        top: wall,
-    };
+    let edges = Edges::closed();
     let lat = Lattice::<f64>::new(nx, ny, edges, vec![false; nx * ny])
         .map_err(|e| Error::Other(format!("lattice: {e}")))?;
     let mut lbm = CoupledFluid::new(Lbm::new(

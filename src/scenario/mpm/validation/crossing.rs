@@ -164,23 +164,7 @@ pub fn prestressed_translation(shape: ShapeKind, cells_moved: f64) -> Result<Tra
 pub fn compaction_error(shape: ShapeKind, youngs: f64) -> Result<(f64, f64)> {
     let (rho, g, hgt, h) = (1000.0, 9.81, 1.0, 0.05);
     let w = 2.0 * h;
-    let walls = vec![
-        Wall {
-            side: Side::Left,
-            position: 0.0,
-            kind: WallKind::Roller,
-        },
-        Wall {
-            side: Side::Right,
-            position: w,
-            kind: WallKind::Roller,
-        },
-        Wall {
-            side: Side::Bottom,
-            position: 0.0,
-            kind: WallKind::Fixed,
-        },
-    ];
+    let walls = column_walls(w);
     let mat = MaterialModel::Elastic(elastic(rho, youngs, 0.0));
     let mut mpm = block(
         w,

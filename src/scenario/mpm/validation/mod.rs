@@ -91,6 +91,27 @@ fn block(
     Mpm::new(grid, pts, material, params)
 }
 
+/// A column's walls: rollers at x = 0 and x = `w`, a fixed base at y = 0.
+fn column_walls(w: f64) -> Vec<Wall> {
+    vec![
+        Wall {
+            side: Side::Left,
+            position: 0.0,
+            kind: WallKind::Roller,
+        },
+        Wall {
+            side: Side::Right,
+            position: w,
+            kind: WallKind::Roller,
+        },
+        Wall {
+            side: Side::Bottom,
+            position: 0.0,
+            kind: WallKind::Fixed,
+        },
+    ]
+}
+
 fn material_density(m: &MaterialModel) -> f64 {
     use crate::mpm::material::Material;
     m.density()

@@ -12,23 +12,7 @@ pub fn selfweight(fidelity: Fidelity) -> Result<Vec<Check>> {
     };
     let h = hgt / cells as f64;
     let w = 4.0 * h;
-    let walls = vec![
-        Wall {
-            side: Side::Left,
-            position: 0.0,
-            kind: WallKind::Roller,
-        },
-        Wall {
-            side: Side::Right,
-            position: w,
-            kind: WallKind::Roller,
-        },
-        Wall {
-            side: Side::Bottom,
-            position: 0.0,
-            kind: WallKind::Fixed,
-        },
-    ];
+    let walls = column_walls(w);
     let mat = MaterialModel::Elastic(elastic(rho, 1e7, 0.3));
     // Local damping α = 0.3 (Cundall) takes the column to rest; 2 s ≈ 40 fundamental periods
     // 4H/c (c ≈ 82 m/s).

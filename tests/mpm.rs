@@ -342,7 +342,7 @@ fn musl_remap_keeps_the_floor_contact_of_the_update() {
         resort_every: 0,
     };
     let mut mpm = Mpm::new(grid, pts, material, params).unwrap();
-    mpm.set_stress(|_| [-2e4, -2e4, 0.0, -2e4]);
+    mpm.set_stress(|_| [-2e4, -2e4, 0.0, -2e4]).unwrap();
     mpm.step().unwrap();
     let g = &mpm.grid;
     let mut held = 0;

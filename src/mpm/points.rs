@@ -3,9 +3,9 @@
 
 use super::material::{MaterialState, Stress};
 
-/// The material points.
-#[derive(Clone, Debug, Default)]
-pub struct Points {
+/// The material points, with the per-point state `S` of their material law.
+#[derive(Clone, Debug)]
+pub struct Points<S = MaterialState> {
     /// Position (m).
     pub pos: Vec<[f64; 2]>,
     /// Initial position (m), for Lagrangian reference solutions.
@@ -22,8 +22,8 @@ pub struct Points {
     pub def_grad: Vec<[f64; 4]>,
     /// Cauchy stress (xx, yy, xy, zz), Pa, tension positive.
     pub stress: Vec<Stress>,
-    /// Plastic history.
-    pub state: Vec<MaterialState>,
+    /// The material law's per-point state (plastic history, or a representative volume).
+    pub state: Vec<S>,
     /// uGIMP half-width l_p of the point's domain (m); constant (not updated).
     pub half_size: Vec<f64>,
     /// Stress work done on the point, ∫ σ : D V dt (J per m), plus its initial elastic energy.
@@ -33,7 +33,26 @@ pub struct Points {
     pub affine: Vec<[f64; 4]>,
 }
 
-impl Points {
+impl<S> Default for Points<S> {
+    fn default() -> Self {
+        Points {
+            pos: Vec::new(),
+            pos0: Vec::new(),
+            vel: Vec::new(),
+            mass: Vec::new(),
+            vol: Vec::new(),
+            vol0: Vec::new(),
+            def_grad: Vec::new(),
+            stress: Vec::new(),
+            state: Vec::new(),
+            half_size: Vec::new(),
+            work: Vec::new(),
+            affine: Vec::new(),
+        }
+    }
+}
+
+impl<S: Default> Points<S> {
     /// Number of points.
     pub fn len(&self) -> usize {
         self.pos.len()
@@ -53,7 +72,7 @@ impl Points {
         self.vol0.push(vol);
         self.def_grad.push([1.0, 0.0, 0.0, 1.0]);
         self.stress.push([0.0; 4]);
-        self.state.push(MaterialState::default());
+        self.state.push(S::default());
         self.half_size.push(half_size);
         self.work.push(0.0);
         self.affine.push([0.0; 4]);
@@ -75,7 +94,7 @@ impl Points {
     }
 
     /// Reorder every field by `perm` (new k ← old perm[k]), with `scratch` buffers reused.
-    pub fn permute(&mut self, perm: &[u32], scratch: &mut PermuteScratch) {
+    pub fn permute(&mut self, perm: &[u32], scratch: &mut PermuteScratch<S>) {
         fn apply<T: Copy>(v: &mut Vec<T>, perm: &[u32], s: &mut Vec<T>) {
             s.clear();
             s.extend(perm.iter().map(|&k| v[k as usize]));
@@ -92,15 +111,33 @@ impl Points {
         apply(&mut self.def_grad, perm, &mut scratch.v4);
         apply(&mut self.stress, perm, &mut scratch.v4);
         apply(&mut self.affine, perm, &mut scratch.v4);
-        apply(&mut self.state, perm, &mut scratch.st);
+        // The states are moved out (a representative volume is not copied).
+        let st = &mut scratch.st;
+        st.clear();
+        st.extend(
+            perm.iter()
+                .map(|&k| std::mem::take(&mut self.state[k as usize])),
+        );
+        std::mem::swap(&mut self.state, st);
     }
 }
 
 /// Reused buffers of [`Points::permute`].
-#[derive(Clone, Debug, Default)]
-pub struct PermuteScratch {
+#[derive(Clone, Debug)]
+pub struct PermuteScratch<S> {
     s: Vec<f64>,
     v2: Vec<[f64; 2]>,
     v4: Vec<[f64; 4]>,
-    st: Vec<MaterialState>,
+    st: Vec<S>,
+}
+
+impl<S> Default for PermuteScratch<S> {
+    fn default() -> Self {
+        PermuteScratch {
+            s: Vec::new(),
+            v2: Vec::new(),
+            v4: Vec::new(),
+            st: Vec::new(),
+        }
+    }
 }

@@ -1,6 +1,7 @@
 //! [`Scale`] implementation: the MPM continuum as a submodel; `advance(dt)` sub-cycles steps of
 //! at most the CFL step ([`crate::scale::substeps`]).
 
+use super::material::Material;
 use super::solver::Mpm;
 use crate::scale::Scale;
 use crate::Result;
@@ -16,10 +17,10 @@ pub struct PointView {
     pub vol: Vec<f64>,
 }
 
-impl Scale for Mpm {
+impl<M: Material + Clone + 'static> Scale for Mpm<M> {
     type Input = ();
     type Output = PointView;
-    type Snapshot = Box<Mpm>;
+    type Snapshot = Box<Mpm<M>>;
 
     fn time(&self) -> f64 {
         Mpm::time(self)
@@ -36,10 +37,10 @@ impl Scale for Mpm {
         out.vel.clone_from(&self.points.vel);
         out.vol.clone_from(&self.points.vol);
     }
-    fn snapshot(&self) -> Box<Mpm> {
+    fn snapshot(&self) -> Box<Mpm<M>> {
         Box::new(self.clone())
     }
-    fn restore(&mut self, s: Box<Mpm>) {
+    fn restore(&mut self, s: Box<Mpm<M>>) {
         *self = *s;
     }
 }

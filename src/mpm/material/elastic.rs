@@ -2,7 +2,7 @@
 //! Δσ = λ tr(Δε) I + 2G Δε, with λ = Eν/((1+ν)(1−2ν)), G = E/(2(1+ν)), Δε_zz = 0, so
 //! Δσ_zz = λ (Δε_xx + Δε_yy).
 
-use super::{jaumann, Material, MaterialState, Strain, Stress};
+use super::{jaumann, Failure, Material, MaterialState, Strain, Stress};
 
 /// Linear isotropic elasticity.
 #[derive(Clone, Copy, Debug)]
@@ -56,6 +56,7 @@ impl LinearElastic {
 }
 
 impl Material for LinearElastic {
+    type State = MaterialState;
     fn update_stress(
         &self,
         stress: &Stress,
@@ -63,8 +64,8 @@ impl Material for LinearElastic {
         spin: f64,
         _dt: f64,
         _: &mut MaterialState,
-    ) -> Stress {
-        self.trial(stress, de, spin)
+    ) -> Result<Stress, Failure> {
+        Ok(self.trial(stress, de, spin))
     }
     fn density(&self) -> f64 {
         self.density
@@ -72,7 +73,7 @@ impl Material for LinearElastic {
     fn p_wave_modulus(&self) -> f64 {
         self.bulk_modulus() + 4.0 / 3.0 * self.shear_modulus()
     }
-    fn elastic_energy_density(&self, s: &Stress) -> f64 {
+    fn elastic_energy_density(&self, s: &Stress, _: &MaterialState) -> f64 {
         self.energy_density(s)
     }
 }

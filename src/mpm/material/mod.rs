@@ -25,7 +25,7 @@ pub type Stress = [f64; 4];
 /// Strain increment (tensor components): xx, yy, xy (= ½ γ_xy). zz is 0 in plane strain.
 pub type Strain = [f64; 3];
 
-/// Per-point history a material may keep (no heap object per point: one of these per point,
+/// Per-point history of the built-in laws (no heap object per point: one of these per point,
 /// stored in a `Vec` beside the other point arrays).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct MaterialState {
@@ -37,24 +37,54 @@ pub struct MaterialState {
     pub yielding: bool,
 }
 
-/// The material contract (cb-geo's `compute_stress`, with the spin passed for objectivity),
-/// so a DEM representative volume can later stand behind the same interface.
+/// Why a point's stress update failed (the solver adds which point, where and when).
+pub type Failure = String;
+
+/// The material contract (cb-geo's `compute_stress`, with the spin passed for objectivity).
+///
+/// A law carries its own per-point state type: a few numbers for Mohr–Coulomb
+/// ([`MaterialState`]), a whole grain packing for a DEM representative volume (which lives
+/// outside `mpm/`, in `crate::multiscale`). The MPM solver is generic over the law, so the
+/// built-in laws keep a hot loop without virtual calls.
 pub trait Material: Sync + Send {
-    /// Stress after a step of `dt` with strain increment `dstrain` and spin increment `spin`.
+    /// The per-point history (moved, never copied, when the points are re-sorted).
+    type State: Clone + Default + Send + Sync + std::fmt::Debug;
+    /// Points per parallel task of the stress update: many for a cheap closed-form law, one for
+    /// a law that runs a simulation per point.
+    const POINTS_PER_TASK: usize = 512;
+
+    /// Stress after a step of `dt` with strain increment `dstrain` and spin increment `spin`;
+    /// a failure says why (e.g. a representative volume that went unstable).
     fn update_stress(
         &self,
         stress: &Stress,
         dstrain: &Strain,
         spin: f64,
         dt: f64,
-        state: &mut MaterialState,
-    ) -> Stress;
+        state: &mut Self::State,
+    ) -> Result<Stress, Failure>;
     /// Mass density ρ (kg/m³).
     fn density(&self) -> f64;
     /// P-wave modulus K + 4G/3 (Pa), for the CFL step.
     fn p_wave_modulus(&self) -> f64;
-    /// Elastic strain energy density ½ σ : C⁻¹ : σ (J/m³) of a stress.
-    fn elastic_energy_density(&self, stress: &Stress) -> f64;
+    /// Stored (elastic) energy density (J/m³) of a point at `stress` with `state`:
+    /// ½ σ : C⁻¹ : σ for the continuum laws.
+    fn elastic_energy_density(&self, stress: &Stress, state: &Self::State) -> f64;
+    /// The state a point starts with at the initial stress `stress`, and the stress it really
+    /// starts with (the built-in laws take any stress; a representative volume starts from a
+    /// packing whose own stress it reports).
+    fn initial_state(&self, stress: &Stress) -> Result<(Self::State, Stress), Failure> {
+        Ok((Self::State::default(), *stress))
+    }
+}
+
+/// Mean stress p = (σ_xx + σ_yy + σ_zz)/3 and von Mises equivalent deviatoric stress
+/// q = √(3/2 s:s) of a stress.
+pub fn invariants(s: &Stress) -> (f64, f64) {
+    let p = (s[0] + s[1] + s[3]) / 3.0;
+    let d = [s[0] - p, s[1] - p, s[3] - p];
+    let j2 = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + s[2] * s[2];
+    (p, (3.0 * j2).sqrt())
 }
 
 /// Jaumann co-rotation of `s` by the spin increment `w` (see the module doc).
@@ -81,6 +111,7 @@ pub enum MaterialModel {
 }
 
 impl Material for MaterialModel {
+    type State = MaterialState;
     #[inline]
     fn update_stress(
         &self,
@@ -89,7 +120,7 @@ impl Material for MaterialModel {
         spin: f64,
         dt: f64,
         state: &mut MaterialState,
-    ) -> Stress {
+    ) -> Result<Stress, Failure> {
         match self {
             MaterialModel::Elastic(m) => m.update_stress(stress, dstrain, spin, dt, state),
             MaterialModel::MohrCoulomb(m) => m.update_stress(stress, dstrain, spin, dt, state),
@@ -110,11 +141,11 @@ impl Material for MaterialModel {
             MaterialModel::MuI(m) => m.p_wave_modulus(),
         }
     }
-    fn elastic_energy_density(&self, stress: &Stress) -> f64 {
+    fn elastic_energy_density(&self, stress: &Stress, state: &MaterialState) -> f64 {
         match self {
-            MaterialModel::Elastic(m) => m.elastic_energy_density(stress),
-            MaterialModel::MohrCoulomb(m) => m.elastic_energy_density(stress),
-            MaterialModel::MuI(m) => m.elastic_energy_density(stress),
+            MaterialModel::Elastic(m) => m.elastic_energy_density(stress, state),
+            MaterialModel::MohrCoulomb(m) => m.elastic_energy_density(stress, state),
+            MaterialModel::MuI(m) => m.elastic_energy_density(stress, state),
         }
     }
 }

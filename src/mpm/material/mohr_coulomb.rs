@@ -24,7 +24,7 @@
 //! The principal directions in the plane are those of σ_B (isotropic elasticity keeps them).
 
 use super::elastic::LinearElastic;
-use super::{Material, MaterialState, Strain, Stress};
+use super::{Failure, Material, MaterialState, Strain, Stress};
 
 /// Mohr–Coulomb parameters, with the constants of the return mapping (k, m, σ_c, apex, λ,
 /// 2G) derived once in [`MohrCoulomb::new`] rather than per call (they need sin/cos of the
@@ -322,6 +322,7 @@ impl MohrCoulomb {
 }
 
 impl Material for MohrCoulomb {
+    type State = MaterialState;
     #[inline]
     fn update_stress(
         &self,
@@ -330,8 +331,8 @@ impl Material for MohrCoulomb {
         spin: f64,
         _dt: f64,
         state: &mut MaterialState,
-    ) -> Stress {
-        self.update(stress, de, spin, state).0
+    ) -> Result<Stress, Failure> {
+        Ok(self.update(stress, de, spin, state).0)
     }
     fn density(&self) -> f64 {
         self.elastic.density
@@ -339,7 +340,7 @@ impl Material for MohrCoulomb {
     fn p_wave_modulus(&self) -> f64 {
         self.elastic.p_wave_modulus()
     }
-    fn elastic_energy_density(&self, s: &Stress) -> f64 {
+    fn elastic_energy_density(&self, s: &Stress, _: &MaterialState) -> f64 {
         self.elastic.energy_density(s)
     }
 }

@@ -18,7 +18,7 @@
 //! angle, cohesion and tension cut-off are as there.
 
 use super::mohr_coulomb::MohrCoulomb;
-use super::{Material, MaterialState, Strain, Stress};
+use super::{Failure, Material, MaterialState, Strain, Stress};
 
 /// The μ(I) Mohr–Coulomb material.
 #[derive(Clone, Copy, Debug)]
@@ -81,6 +81,7 @@ impl MuIMohrCoulomb {
 }
 
 impl Material for MuIMohrCoulomb {
+    type State = MaterialState;
     #[inline]
     fn update_stress(
         &self,
@@ -89,11 +90,11 @@ impl Material for MuIMohrCoulomb {
         spin: f64,
         dt: f64,
         state: &mut MaterialState,
-    ) -> Stress {
+    ) -> Result<Stress, Failure> {
         let i = self.inertial_number(stress, de, dt);
         let sin_phi = self.sin_phi(i);
         if sin_phi == self.sin_s {
-            return self.base.update(stress, de, spin, state).0;
+            return Ok(self.base.update(stress, de, spin, state).0);
         }
         let b = &self.base;
         let m = MohrCoulomb::new(
@@ -103,7 +104,7 @@ impl Material for MuIMohrCoulomb {
             b.cohesion(),
             b.tension_cutoff(),
         );
-        m.update(stress, de, spin, state).0
+        Ok(m.update(stress, de, spin, state).0)
     }
     fn density(&self) -> f64 {
         self.base.density()
@@ -111,8 +112,8 @@ impl Material for MuIMohrCoulomb {
     fn p_wave_modulus(&self) -> f64 {
         self.base.p_wave_modulus()
     }
-    fn elastic_energy_density(&self, s: &Stress) -> f64 {
-        self.base.elastic_energy_density(s)
+    fn elastic_energy_density(&self, s: &Stress, state: &MaterialState) -> f64 {
+        self.base.elastic_energy_density(s, state)
     }
 }
 
@@ -143,7 +144,7 @@ mod tests {
             let mut st = MaterialState::default();
             let de = [0.0, 0.0, 0.5 * gdot * dt];
             for _ in 0..200_000 {
-                s = m.update_stress(&s, &de, 0.0, dt, &mut st);
+                s = m.update_stress(&s, &de, 0.0, dt, &mut st).unwrap();
             }
             let p = -0.5 * (s[0] + s[1]);
             let r = (0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2]).sqrt();

@@ -63,7 +63,7 @@
 use rayon::prelude::*;
 
 use super::grid::{Grid, NodeSums};
-use super::material::{Material, MaterialModel, MaterialState, Stress};
+use super::material::{Material, MaterialModel, Stress};
 use super::points::{PermuteScratch, Points};
 use super::shape::{weights_1d, ShapeKind};
 use crate::{Error, Result};
@@ -203,18 +203,19 @@ pub struct Traction {
 
 /// Columns per stripe of the parallel P2G.
 const STRIPE: usize = 4;
-/// Points per parallel work item of the point loops.
+/// Points per parallel work item of the point loops (the stress update uses the material's
+/// own [`Material::POINTS_PER_TASK`]).
 const CHUNK: usize = 512;
 
-/// The MPM system.
+/// The MPM system, generic over its constitutive law `M` (the built-in laws by default).
 #[derive(Clone, Debug)]
-pub struct Mpm {
+pub struct Mpm<M: Material = MaterialModel> {
     /// Background grid.
     pub grid: Grid,
     /// Material points.
-    pub points: Points,
+    pub points: Points<M::State>,
     /// Constitutive law (one material for all points).
-    pub material: MaterialModel,
+    pub material: M,
     /// Parameters.
     pub params: MpmParams,
     dt: f64,
@@ -225,7 +226,7 @@ pub struct Mpm {
     stripe_start: Vec<usize>,
     stripe_of: Vec<u32>,
     perm: Vec<u32>,
-    scratch: PermuteScratch,
+    scratch: PermuteScratch<M::State>,
     mass_eps: f64,
     /// Each point's stencil at the start of the step (computed once in `bin`, used by every
     /// pass of the step: the positions move only at the end of the last pass).
@@ -264,7 +265,7 @@ fn stencil(shape: ShapeKind, origin: [f64; 2], h: f64, p: [f64; 2], lp: f64) -> 
 }
 
 /// The CFL limit C h/c, c = √((K + 4G/3)/ρ).
-pub fn cfl_step(material: &MaterialModel, h: f64, courant: f64) -> f64 {
+pub fn cfl_step(material: &impl Material, h: f64, courant: f64) -> f64 {
     courant * h / (material.p_wave_modulus() / material.density()).sqrt()
 }
 
@@ -283,14 +284,14 @@ enum PointPass {
     VelocityAndMove,
 }
 
-impl Mpm {
+impl<M: Material> Mpm<M> {
     /// Assemble a system. Refuses (naming `time.dt`) a step above the CFL limit, a Courant
     /// number outside (0, 1], damping outside [0, 1), more than 8 walls, or points outside
     /// the grid's interior.
     pub fn new(
         grid: Grid,
-        points: Points,
-        material: MaterialModel,
+        points: Points<M::State>,
+        material: M,
         params: MpmParams,
     ) -> Result<Self> {
         if !(params.courant > 0.0 && params.courant <= 1.0) {
@@ -361,8 +362,11 @@ impl Mpm {
         };
         // The stress work starts at the initial elastic energy (so plastic = work − elastic).
         for p in 0..n {
-            mpm.points.work[p] =
-                mpm.points.vol[p] * mpm.material.elastic_energy_density(&mpm.points.stress[p]);
+            let pts = &mut mpm.points;
+            pts.work[p] = pts.vol[p]
+                * mpm
+                    .material
+                    .elastic_energy_density(&pts.stress[p], &pts.state[p]);
         }
         mpm.resort();
         mpm.bin()?;
@@ -410,13 +414,31 @@ impl Mpm {
         self.steps
     }
 
-    /// Set the initial stress of every point (and its stress work to the elastic energy).
-    pub fn set_stress(&mut self, f: impl Fn([f64; 2]) -> Stress) {
-        for p in 0..self.points.len() {
-            self.points.stress[p] = f(self.points.pos[p]);
-            self.points.work[p] =
-                self.points.vol[p] * self.material.elastic_energy_density(&self.points.stress[p]);
+    /// Set the initial stress of every point (and its stress work to the elastic energy),
+    /// with the state the material starts a point with at that stress
+    /// ([`Material::initial_state`]; the stress a point really starts with may differ for a
+    /// representative volume). Refuses a stress the material cannot start from, naming the
+    /// point.
+    pub fn set_stress(&mut self, f: impl Fn([f64; 2]) -> Stress + Sync) -> Result<()> {
+        let material = &self.material;
+        let p = &mut self.points;
+        let started: Vec<_> = p
+            .pos
+            .par_iter()
+            .map(|&x| material.initial_state(&f(x)))
+            .collect();
+        for (q, s) in started.into_iter().enumerate() {
+            let (state, stress) = s.map_err(|why| {
+                Error::Other(format!(
+                    "initial stress of material point {q} at {:?}: {why}",
+                    p.pos[q]
+                ))
+            })?;
+            p.work[q] = p.vol[q] * material.elastic_energy_density(&stress, &state);
+            p.stress[q] = stress;
+            p.state[q] = state;
         }
+        Ok(())
     }
 
     /// Add pressure loads on boundary faces of points. Refuses a point index out of range, a
@@ -604,7 +626,7 @@ impl Mpm {
             .map(|q| {
                 let v = p.vel[q];
                 let m = p.mass[q];
-                let el = p.vol[q] * mat.elastic_energy_density(&p.stress[q]);
+                let el = p.vol[q] * mat.elastic_energy_density(&p.stress[q], &p.state[q]);
                 [
                     0.5 * m * (v[0] * v[0] + v[1] * v[1]),
                     -m * (gv[0] * p.pos[q][0] + gv[1] * p.pos[q][1]),
@@ -661,17 +683,8 @@ impl Mpm {
         Ok(())
     }
 
-    /// Mean stress p = (σ_xx + σ_yy + σ_zz)/3 and von Mises equivalent deviatoric stress
-    /// q = √(3/2 s:s) of a point.
-    pub fn invariants(s: &Stress) -> (f64, f64) {
-        let p = (s[0] + s[1] + s[3]) / 3.0;
-        let d = [s[0] - p, s[1] - p, s[3] - p];
-        let j2 = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + s[2] * s[2];
-        (p, (3.0 * j2).sqrt())
-    }
-
     /// The material state of point `q`.
-    pub fn state(&self, q: usize) -> MaterialState {
-        self.points.state[q]
+    pub fn state(&self, q: usize) -> &M::State {
+        &self.points.state[q]
     }
 }

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use super::*;
 
-impl Mpm {
+impl<M: Material> Mpm<M> {
     /// Re-sort the points into cell order (x-major, as the nodes).
     pub(super) fn resort(&mut self) {
         let g = &self.grid;
@@ -332,17 +332,18 @@ impl Mpm {
         );
         let stencils = &self.stencils;
         let p = &mut self.points;
+        let chunk = if do_s { M::POINTS_PER_TASK } else { CHUNK };
         let bad = (
-            p.pos.par_chunks_mut(CHUNK),
-            p.vel.par_chunks_mut(CHUNK),
-            p.def_grad.par_chunks_mut(CHUNK),
-            p.vol.par_chunks_mut(CHUNK),
-            p.stress.par_chunks_mut(CHUNK),
-            p.state.par_chunks_mut(CHUNK),
-            p.work.par_chunks_mut(CHUNK),
-            p.vol0.par_chunks(CHUNK),
-            stencils.par_chunks(CHUNK),
-            p.affine.par_chunks_mut(CHUNK),
+            p.pos.par_chunks_mut(chunk),
+            p.vel.par_chunks_mut(chunk),
+            p.def_grad.par_chunks_mut(chunk),
+            p.vol.par_chunks_mut(chunk),
+            p.stress.par_chunks_mut(chunk),
+            p.state.par_chunks_mut(chunk),
+            p.work.par_chunks_mut(chunk),
+            p.vol0.par_chunks(chunk),
+            stencils.par_chunks(chunk),
+            p.affine.par_chunks_mut(chunk),
         )
             .into_par_iter()
             .enumerate()
@@ -409,14 +410,20 @@ impl Mpm {
                             ];
                             let j = fnew[0] * fnew[3] - fnew[1] * fnew[2];
                             if (j.is_nan() || j <= 0.0) && bad.is_none() {
-                                bad = Some((k * CHUNK + q, format!("det F = {j:e} ≤ 0")));
+                                bad = Some((k * chunk + q, format!("det F = {j:e} ≤ 0")));
                             }
                             fg[q] = fnew;
                             let vnew_ = j * vol0[q];
                             let de = [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])];
                             let spin = 0.5 * dt * (l[1] - l[2]);
                             let s0 = sig[q];
-                            let s1 = mat.update_stress(&s0, &de, spin, dt, &mut state[q]);
+                            let s1 = match mat.update_stress(&s0, &de, spin, dt, &mut state[q]) {
+                                Ok(s1) => s1,
+                                Err(why) => {
+                                    bad = bad.or(Some((k * chunk + q, why)));
+                                    s0
+                                }
+                            };
                             let smid = [
                                 0.5 * (s0[0] + s1[0]),
                                 0.5 * (s0[1] + s1[1]),

@@ -29,6 +29,7 @@ use super::{run_column, steps_per_row, Column, Plan, Row, Tally};
 use crate::analysis::runout::CollapseOutcome;
 use crate::exec::Progress;
 use crate::io::{write_vti, write_vtu_points, Field, ImageGrid, PvdSeries};
+use crate::mpm::material::invariants;
 use crate::mpm::solver::{Mpm, MpmEnergy};
 use crate::scenario::mpm::spec::MpmScenario;
 use crate::Result;
@@ -152,7 +153,7 @@ fn write_frame(mpm: &Mpm, dir: &Path, k: usize, pvd: &mut PvdSeries) -> Result<(
     let n = p.len();
     let comp = |c: usize| -> Vec<f64> { p.stress.iter().map(|s| s[c]).collect() };
     let (sxx, syy, sxy, szz) = (comp(0), comp(1), comp(2), comp(3));
-    let inv: Vec<(f64, f64)> = p.stress.iter().map(Mpm::invariants).collect();
+    let inv: Vec<(f64, f64)> = p.stress.iter().map(invariants).collect();
     let mean: Vec<f64> = inv.iter().map(|v| v.0).collect();
     let dev: Vec<f64> = inv.iter().map(|v| v.1).collect();
     let eps: Vec<f64> = p.state.iter().map(|s| s.plastic_strain).collect();

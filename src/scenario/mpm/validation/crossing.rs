@@ -130,7 +130,7 @@ pub fn prestressed_translation(shape: ShapeKind, cells_moved: f64) -> Result<Tra
         params(shape, Scheme::Musl, 0.0, 0.0),
     )?;
     let s0 = [-p, -0.5 * p, 0.0, -0.3 * 1.5 * p];
-    mpm.set_stress(|_| s0);
+    mpm.set_stress(|_| s0)?;
     let loads = block_tractions(&mpm.points, [0.0, 0.0], [w, hgt], p, 0.5 * p);
     mpm.add_tractions(loads)?;
     for v in mpm.points.vel.iter_mut() {

@@ -154,7 +154,7 @@ pub fn biaxial_on_grid(m: MohrCoulomb, sigma3: f64, steps: u64) -> Result<GridBi
         MaterialModel::MohrCoulomb(m),
         params(ShapeKind::Gimp, Scheme::Musl, 0.0, 0.1),
     )?;
-    mpm.set_stress(|_| [-sigma3, -sigma3, 0.0, -sigma3]);
+    mpm.set_stress(|_| [-sigma3, -sigma3, 0.0, -sigma3])?;
     let loads = block_tractions(&mpm.points, [0.0, 0.0], [w, hgt], sigma3, 0.0)
         .into_iter()
         .filter(|t| t.normal[0] != 0.0);

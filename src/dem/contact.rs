@@ -161,7 +161,7 @@ pub fn critical_step(k: f64, m: f64, xi: f64) -> f64 {
 }
 
 /// A contact law with the constants of [`ContactParams`] precomputed for the force loop.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct Law {
     /// k_n.
     pub k_n: f64,

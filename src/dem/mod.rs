@@ -17,6 +17,8 @@
 //! * [`stress`]: per-grain Love–Weber stress tensor;
 //! * [`packing`]: reproducible packings (gravity deposition, hexagonal);
 //! * [`shear_cell`]: the bi-periodic Lees–Edwards simple-shear cell;
+//! * [`periodic_cell`]: the bi-periodic cell under any imposed velocity gradient (the
+//!   representative volume of the multi-scale material) and its preparation;
 //! * [`scale`]: the [`crate::scale::Scale`] implementation (sub-cycling `advance`).
 
 pub mod contact;
@@ -26,6 +28,7 @@ pub mod grains;
 pub mod neighbours;
 pub mod packing;
 pub mod params;
+pub mod periodic_cell;
 pub mod scale;
 pub mod shape;
 pub mod shape_contacts;

@@ -12,6 +12,9 @@
 //! * [`driver`]: the coupled step over two [`Scale`]s, with the solid sub-cycled by the one
 //!   rule of [`crate::scale::substeps`] and the hydrodynamic force held (seed eq. 5.61).
 //!
+//! Continuum ↔ grains: [`rve`], the DEM representative volume as the material of the MPM's
+//! points ([`RveMaterial`]).
+//!
 //! Buoyancy enters through reduced gravity (1 − ρ_f/ρ_s) g on the grains (seed eq. 5.57); the
 //! fluid then carries no gravity, so there is no hydrostatic pressure to resolve.
 
@@ -19,11 +22,13 @@ pub mod driver;
 pub mod fluid;
 pub mod ladd;
 pub mod psm;
+pub mod rve;
 
 pub use driver::{Coupled, Exchange};
 pub use fluid::{CellForces, CoupledFluid, SolidCover};
 pub use ladd::LaddMap;
 pub use psm::{DiskCover, Grid};
+pub use rve::RveMaterial;
 
 use crate::dem::scale::GrainView;
 use crate::dem::ExternalLoads;

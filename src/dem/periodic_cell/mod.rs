@@ -167,6 +167,11 @@ impl PeriodicCell {
         &self.cell
     }
 
+    /// Axial length t of the disks (m).
+    pub fn thickness(&self) -> f64 {
+        self.thickness
+    }
+
     /// The DEM step (s).
     pub fn dt(&self) -> f64 {
         self.dt
@@ -192,6 +197,38 @@ impl PeriodicCell {
     pub fn packing_fraction(&self) -> f64 {
         let a: f64 = self.r.iter().map(|r| std::f64::consts::PI * r * r).sum();
         a / self.area()
+    }
+
+    /// Bulk density Σ m / (A t) = ρ_s φ (kg/m³).
+    pub fn bulk_density(&self) -> f64 {
+        self.m.iter().sum::<f64>() / (self.area() * self.thickness)
+    }
+
+    /// The affine (Voigt) P-wave modulus, the larger of C_xxxx and C_yyyy with
+    /// C_aaaa = (1/(A t)) Σ_c |**l**|² (k_n n_a⁴ + k_t n_a² n_b²) over touching pairs (Pa): an
+    /// upper bound of the packing's stiffness (the grains' relaxation only softens it), so a
+    /// wave speed √(C/ρ) from it is a safe CFL bound for a continuum made of this packing.
+    pub fn affine_modulus(&self) -> f64 {
+        let inv = self.cell.try_inverse().expect("a cell of positive area");
+        let (kn, kt) = (self.law.k_n, self.law.k_t);
+        let mut c = [0.0f64; 2];
+        for (k, &(i, j)) in self.pairs.iter().enumerate() {
+            if !self.state[k].touching() {
+                continue;
+            }
+            let (i, j) = (i as usize, j as usize);
+            let (dx, dy) = Self::min_image(
+                &inv,
+                &self.cell,
+                self.x[j] - self.x[i],
+                self.y[j] - self.y[i],
+            );
+            let l2 = dx * dx + dy * dy;
+            let (nx2, ny2) = (dx * dx / l2, dy * dy / l2);
+            c[0] += l2 * (kn * nx2 * nx2 + kt * nx2 * ny2);
+            c[1] += l2 * (kn * ny2 * ny2 + kt * nx2 * ny2);
+        }
+        c[0].max(c[1]) / (self.area() * self.thickness)
     }
 
     /// Touching pairs per grain, 2 N_c / N.

@@ -1,0 +1,129 @@
+//! The DEM representative volume as the constitutive law of an MPM material point (FEM×DEM,
+//! Guo & Zhao 2014; MPM×DEM, Liang & Zhao 2019; seed section 4.1, figure 4.1): each point
+//! carries a bi-periodic grain packing ([`PeriodicCell`]) and asks it for its stress.
+//!
+//! **One MPM step of one point**, given the strain increment Δε = Δt sym L and the spin
+//! increment Δω = Δt ½(L_xy − L_yx) of [`crate::mpm::material`]:
+//!
+//! 1. the cell turns rigidly by the material rotation of the step, θ = −Δω counter-clockwise
+//!    ([`PeriodicCell::rotate`]: grains, cell, velocities and forces, exactly, so the stress
+//!    turns to R σ Rᵀ and nothing else changes — the law is objective by construction);
+//! 2. the cell deforms homogeneously with the stretching D = Δε/Δt over the step's duration Δt,
+//!    in n = ⌈Δt/Δt_DEM⌉ DEM sub-steps ([`crate::scale::substeps`], the one sub-cycling rule):
+//!    the grains follow the affine map and relax through their contacts, so the volume lives on
+//!    the same clock as the continuum and its inertial number is the physical one;
+//! 3. the point's stress is the cell's Love–Weber stress with the kinetic part (tension
+//!    positive), symmetrised: σ_xy = ½(σ_xy + σ_yx); the out-of-plane σ_zz of a 2-D packing is
+//!    taken as the in-plane mean ½(σ_xx + σ_yy) (it enters only the reported invariants).
+//!
+//! A point's state is its cell (grains, velocities, contact springs, cell matrix): moved, not
+//! copied, when the points are re-sorted, and copied whole by the MPM's snapshot, so a redone
+//! step restores it. A cell that fails (grains through each other, a cell thinner than two
+//! cut-offs, a state no longer finite) fails the point's update with the reason.
+//!
+//! **Initial state.** Every point starts from a copy of one prepared packing (a
+//! [`crate::dem::periodic_cell::Preparation`] at the target packing fraction and isotropic
+//! pressure p₀) and starts with that packing's stress, whatever stress the scenario asks for: a
+//! column is released from the isotropic state p₀ and takes its own geostatic state under
+//! gravity. Choose p₀ near the mean geostatic stress of the body.
+//!
+//! **Continuum constants.** The density is the packing's bulk density ρ_s φ; the P-wave modulus
+//! for the CFL step is the packing's affine (Voigt) modulus, an upper bound of its stiffness.
+
+use crate::dem::periodic_cell::{PeriodicCell, Tensor};
+use crate::mpm::material::{Failure, Material, Strain, Stress};
+use crate::scale::substeps;
+
+/// The representative-volume material: one prepared packing, copied to every point.
+#[derive(Clone, Debug)]
+pub struct RveMaterial {
+    template: PeriodicCell,
+    density: f64,
+    p_wave: f64,
+}
+
+impl RveMaterial {
+    /// The material of points that start as copies of `template`. Refuses an empty packing or
+    /// one without contacts (no stiffness).
+    pub fn new(template: PeriodicCell) -> Result<Self, String> {
+        if template.is_empty() {
+            return Err("the representative volume holds no grain".into());
+        }
+        let p_wave = template.affine_modulus();
+        if !(p_wave > 0.0) {
+            return Err("the representative volume has no contacts (no stiffness)".into());
+        }
+        Ok(RveMaterial {
+            density: template.bulk_density(),
+            p_wave,
+            template,
+        })
+    }
+
+    /// The packing every point starts from.
+    pub fn template(&self) -> &PeriodicCell {
+        &self.template
+    }
+
+    /// DEM sub-steps one point takes in an MPM step of `dt`.
+    pub fn substeps(&self, dt: f64) -> u64 {
+        substeps(dt, self.template.dt()).0
+    }
+}
+
+/// A cell's stress in the MPM's layout (xx, yy, xy, zz), see the module doc.
+pub fn point_stress(cell: &PeriodicCell) -> Stress {
+    let s = cell.stress();
+    let (xx, yy) = (s[(0, 0)], s[(1, 1)]);
+    [xx, yy, 0.5 * (s[(0, 1)] + s[(1, 0)]), 0.5 * (xx + yy)]
+}
+
+impl Material for RveMaterial {
+    type State = PeriodicCell;
+    /// Each point runs a simulation: one point per parallel task.
+    const POINTS_PER_TASK: usize = 1;
+
+    fn update_stress(
+        &self,
+        _stress: &Stress,
+        de: &Strain,
+        spin: f64,
+        dt: f64,
+        cell: &mut PeriodicCell,
+    ) -> Result<Stress, Failure> {
+        if cell.is_empty() {
+            return Err(
+                "the point has no representative volume (its initial state was not set)".into(),
+            );
+        }
+        cell.rotate(-spin);
+        let stretching = Tensor::new(de[0], de[2], de[2], de[1]) / dt;
+        let (n, h) = substeps(dt, cell.dt());
+        cell.deform(&stretching, n, h)
+            .map_err(|why| format!("representative volume: {why}"))?;
+        Ok(point_stress(cell))
+    }
+
+    fn density(&self) -> f64 {
+        self.density
+    }
+
+    fn p_wave_modulus(&self) -> f64 {
+        self.p_wave
+    }
+
+    /// The energy in the cell's springs per unit volume.
+    fn elastic_energy_density(&self, _stress: &Stress, cell: &PeriodicCell) -> f64 {
+        if cell.is_empty() {
+            return 0.0;
+        }
+        cell.energy().stored / (cell.area() * cell.thickness())
+    }
+
+    fn initial_state(&self, _stress: &Stress) -> Result<(PeriodicCell, Stress), Failure> {
+        Ok((self.template.clone(), point_stress(&self.template)))
+    }
+}
+
+#[cfg(test)]
+mod tests;

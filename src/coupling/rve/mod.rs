@@ -50,7 +50,7 @@ impl RveMaterial {
             return Err("the representative volume holds no grain".into());
         }
         let p_wave = template.affine_modulus();
-        if !(p_wave > 0.0) {
+        if p_wave.is_nan() || p_wave <= 0.0 {
             return Err("the representative volume has no contacts (no stiffness)".into());
         }
         Ok(RveMaterial {

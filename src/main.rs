@@ -88,6 +88,10 @@ enum Command {
         /// Seed of the sample's sizes and deposition (default: the scenario's).
         #[arg(long)]
         seed: Option<u64>,
+        /// Test a bi-periodic representative volume (no walls) prepared at σ₃ and this
+        /// packing fraction, instead of the wall-bounded sample.
+        #[arg(long)]
+        periodic_packing_fraction: Option<f64>,
     },
     /// Periodic simple shear (Lees–Edwards) of a DEM collapse scenario's material at a set of
     /// inertial numbers and a fixed normal stress: its μ(I) and solid fraction φ(I), and the fit
@@ -263,6 +267,7 @@ fn real_main() -> Result<ExitCode> {
             strain,
             prep_friction,
             seed,
+            periodic_packing_fraction,
         } => cli::study::biaxial(
             &scenario,
             &out,
@@ -270,6 +275,7 @@ fn real_main() -> Result<ExitCode> {
             grains,
             prep_friction,
             seed,
+            periodic_packing_fraction,
         ),
         Command::Shear {
             scenario,

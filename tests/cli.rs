@@ -361,3 +361,55 @@ fn the_declared_kind_decides_the_parser() {
     );
     assert!(!dir.path().join("o").exists() && !dir.path().join("s").exists());
 }
+
+/// `granflow check` on a representative-volume (MPM×DEM) file prints the grain counts, the
+/// DEM sub-steps per MPM step and a run-time estimate; bad volume parameters are refused
+/// naming the key and the reason (issue 20).
+#[test]
+fn check_reports_and_refuses_representative_volumes() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/column_collapse/rve_a1.toml");
+    let out = granflow().arg("check").arg(&model).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    for e in [
+        "200 grains per point",
+        "80000 in all",
+        "sub-steps per MPM step",
+        "run time",
+    ] {
+        assert!(text.contains(e), "expected `{e}` in: {text}");
+    }
+    let base = std::fs::read_to_string(&model).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    for (from, to, expect) in [
+        (
+            "grains = 200",
+            "grains = 0",
+            ["material.grains", "at least 16"],
+        ),
+        (
+            "packing_fraction = 0.78",
+            "packing_fraction = 0.95",
+            ["material.packing_fraction", "(0, 0.91)"],
+        ),
+        (
+            "pressure = 300.0",
+            "pressure = 0.0",
+            ["material.pressure", "> 0"],
+        ),
+    ] {
+        let f = dir.path().join("bad.toml");
+        assert!(base.contains(from));
+        std::fs::write(&f, base.replace(from, to)).unwrap();
+        let out = granflow().arg("check").arg(&f).output().unwrap();
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        for e in expect {
+            assert!(err.contains(e), "expected `{e}` in: {err}");
+        }
+    }
+}

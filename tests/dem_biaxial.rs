@@ -1,7 +1,8 @@
 //! Biaxial test of the collapse models' DEM material (`granflow::scenario::dem::biaxial`), 300 grains
 //! at σ₃ = 1 kPa, I = 10⁻³, to ε₁ = 0.3: a loose sample (deposited with the grains' friction,
 //! as the collapse columns) and a dense one (deposited frictionless), ≈ 15 s each, run side by
-//! side.
+//! side; and the periodic representative volume of the same material beside the walls
+//! (`granflow::scenario::dem::rve_biaxial`, ≈ 20 + 17 s in turn).
 
 use granflow::scenario::dem::biaxial::{run_biaxial, BiaxialResult, BiaxialSpec};
 use granflow::scenario::dem::DemScenario;
@@ -66,4 +67,26 @@ fn a_sedimented_sample_consolidates_and_shears() {
         "{}",
         r.initial_packing_fraction
     );
+}
+
+/// The representative volume (a bi-periodic cell, `granflow::dem::periodic_cell`) and the
+/// wall-bounded sample of the same material reach the same critical state: the `rve-biaxial`
+/// validation case at test size (its gates and their sources are in
+/// `granflow::scenario::dem::rve_biaxial::validation`).
+#[test]
+fn the_periodic_volume_and_the_walls_agree_on_the_critical_state() {
+    let checks =
+        granflow::scenario::dem::rve_biaxial::validation(granflow::report::Fidelity::Test).unwrap();
+    for c in &checks {
+        println!(
+            "{}: {} = {:.4} (ref {:.4}, tol {:.2}) {}",
+            c.case,
+            c.quantity,
+            c.value,
+            c.reference,
+            c.tolerance,
+            if c.pass { "ok" } else { "FAIL" }
+        );
+    }
+    assert!(checks.iter().all(|c| c.pass));
 }

@@ -53,8 +53,9 @@ fn compressed_hexagonal_crystal_has_the_analytic_stress() {
     let want = 3f64.sqrt() * K * (2.0 * r - a) / (a * T);
     println!("σ = {s:?}, want {want}, z = {z}");
     assert!((z - 6.0).abs() < 1e-12, "every disk has six contacts");
-    assert!((s[0] / want - 1.0).abs() < 1e-10 && (s[3] / want - 1.0).abs() < 1e-10);
-    assert!(s[1].abs() < 1e-10 * want && s[2].abs() < 1e-10 * want);
+    // Tension positive: the compressed lattice has σ_xx = σ_yy = −want.
+    assert!((-s[(0, 0)] / want - 1.0).abs() < 1e-10 && (-s[(1, 1)] / want - 1.0).abs() < 1e-10);
+    assert!(s[(0, 1)].abs() < 1e-10 * want && s[(1, 0)].abs() < 1e-10 * want);
 }
 
 /// Lees–Edwards images move with the shear: two disks meeting head-on (along y) through the

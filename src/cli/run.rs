@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::fluid::Scenario;
+use granflow::scenario::mpm::spec::Law;
 use granflow::scenario::mpm::MpmScenario;
 use granflow::scenario::submerged::SubmergedScenario;
 use granflow::scenario::{kind_of_file, Kind, ScenarioFile};
@@ -145,9 +146,38 @@ fn check_mpm(path: &Path) -> Result<ExitCode> {
     if let Some(dt) = s.time.dt {
         println!("dt              {dt:.4e} s (given)");
     }
+    if let Law::Volume(p) = &d.material {
+        let dt = s.time.dt.unwrap_or(d.dt_cfl);
+        let sub = granflow::scale::substeps(dt, p.dt).0;
+        let steps = (s.time.end_tc * d.tau_c / dt).ceil();
+        let grain_steps = steps * (sub * (p.grains * d.points) as u64) as f64;
+        let threads = rayon::current_num_threads() as f64;
+        println!(
+            "volumes         {} grains per point, {} in all, φ = {}, p₀ = {} Pa",
+            p.grains,
+            p.grains * d.points,
+            p.packing_fraction,
+            p.pressure
+        );
+        println!(
+            "DEM step        {:.4e} s: {sub} sub-steps per MPM step (the CFL step above is \
+             estimated from the packing before it is prepared)",
+            p.dt
+        );
+        println!(
+            "run time        at most {:.0} s on {threads} threads to end_tc ({:.2e} grain-steps \
+             at {RVE_NS_PER_GRAIN_STEP} ns each, measured; a run at rest stops earlier)",
+            grain_steps * RVE_NS_PER_GRAIN_STEP * 1e-9 / threads,
+            grain_steps
+        );
+    }
     println!("ok");
     Ok(ExitCode::SUCCESS)
 }
+
+/// Cost of one grain in one DEM sub-step of a representative volume, on one core of the 2-core
+/// machines (docs/performance.md, "MPM×DEM"), for `check`'s run-time estimate.
+const RVE_NS_PER_GRAIN_STEP: f64 = 60.0;
 
 fn run_mpm(path: &Path, out: &Path) -> Result<ExitCode> {
     let s = MpmScenario::from_file(path)?;

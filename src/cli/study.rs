@@ -65,7 +65,8 @@ pub fn sweep(path: &Path, out: &Path, jobs: usize) -> Result<ExitCode> {
     }
 }
 
-/// `granflow biaxial`; `[σ₃, I, final strain]`.
+/// `granflow biaxial`; `[σ₃, I, final strain]`; a periodic volume at the packing fraction
+/// `periodic` when given, else the wall-bounded sample.
 pub fn biaxial(
     path: &Path,
     out: &Path,
@@ -73,9 +74,36 @@ pub fn biaxial(
     grains: usize,
     prep_friction: Option<f64>,
     seed: Option<u64>,
+    periodic: Option<f64>,
 ) -> Result<ExitCode> {
-    use granflow::scenario::dem::biaxial::{run_biaxial_to, BiaxialSpec};
+    use granflow::scenario::dem::biaxial::{run_biaxial_to, write_biaxial, BiaxialSpec};
+    use granflow::scenario::dem::rve_biaxial::{run_rve_biaxial, RveBiaxialSpec};
     let s = DemScenario::from_file(path)?;
+    if let Some(phi) = periodic {
+        if prep_friction.is_some() {
+            anyhow::bail!("--prep-friction applies to the wall-bounded sample only");
+        }
+        let spec = RveBiaxialSpec::from_scenario(
+            &s,
+            grains,
+            confining,
+            phi,
+            inertial_number,
+            strain,
+            seed.unwrap_or(s.seed),
+        )?;
+        eprintln!(
+            "{}: periodic biaxial test, {grains} grains at φ = {phi}, σ₃ = {confining} Pa, I = {inertial_number}, to ε₁ = {strain} -> {}",
+            s.name,
+            out.display()
+        );
+        let total = (strain / spec.record_strain) as u64;
+        let r = with_progress(total, "points", |p| run_rve_biaxial(&spec, p))
+            .with_context(|| format!("periodic biaxial test of {} stopped", path.display()))?;
+        write_biaxial(&r, confining, strain, out)?;
+        println!("done: {}", r.done_line());
+        return Ok(ExitCode::SUCCESS);
+    }
     let spec = BiaxialSpec::from_scenario(
         &s,
         grains,

@@ -12,23 +12,24 @@
 //! the profile (the velocity jump across the cell is γ̇ L_y).
 //!
 //! **Normal stress.** The height follows a first-order (Berendsen et al. 1984) barostat on the
-//! measured σ_yy: each step L_y and every y are scaled by 1 + ε̇_yy Δt with
-//! ε̇_yy = β γ̇ (σ_yy − P)/P, β = 0.3, capped at |ε̇_yy| ≤ γ̇ ([`crate::scenario::dem::shear`]). The gain
-//! is constant, so a stationary height (⟨ε̇_yy⟩ = 0) means ⟨σ_yy⟩ = P. Gains that follow the
+//! measured normal stress σ_n = −σ_yy (compression positive): each step L_y and every y are scaled by 1 + ε̇_yy Δt with
+//! ε̇_yy = β γ̇ (σ_n − P)/P, β = 0.3, capped at |ε̇_yy| ≤ γ̇ ([`crate::scenario::dem::shear`]). The gain
+//! is constant, so a stationary height (⟨ε̇_yy⟩ = 0) means ⟨σ_n⟩ = P. Gains that follow the
 //! state bias the mean: with the contact network's affine stiffness in the gain, the jammed
-//! phases (high σ_yy, stiff) relax slower than the loose ones, and σ_yy settled at 1.3 P at
+//! phases (high σ_n, stiff) relax slower than the loose ones, and σ_n settled at 1.3 P at
 //! I = 0.1; β = 0.003 had not finished the dilatancy transient in 4 strain units. With
-//! β = 0.3 the mean σ_yy per unit strain stays within 3 % of P from γ = 1 on at I = 0.003–0.1
+//! β = 0.3 the mean σ_n per unit strain stays within 3 % of P from γ = 1 on at I = 0.003–0.1
 //! (1000 and 300 grains). The preparation compresses a dilute square lattice isotropically at
 //! a fixed rate until the mean stress reaches P.
 //!
-//! **Stress** (compression positive, Love–Weber plus the kinetic part):
-//! σ_ab = (1/(L_x L_y t)) [Σ_c f_a l_b + Σ_i m_i v′_a v′_b], over contacts c with f the force
+//! **Stress** (tension positive, the code's one convention; Love–Weber plus the kinetic part):
+//! σ_ab = −(1/(L_x L_y t)) [Σ_c f_a l_b + Σ_i m_i v′_a v′_b], over contacts c with f the force
 //! on i, **l** = **x**_i − **x**_j (minimum image), and v′ = v − γ̇ (y − L_y/2) **e**_x the
-//! fluctuation. The shear stress is τ = −½(σ_xy + σ_yx) (> 0 for γ̇ > 0).
+//! fluctuation. The reported [`ShearPoint`] is in soil-mechanics terms: normal stresses
+//! compression positive (−σ_xx, −σ_yy) and the shear stress τ = ½(σ_xy + σ_yx) (> 0 for γ̇ > 0).
 //!
-//! **Measured:** μ = τ/σ_yy and I = γ̇ d̄/√(σ_yy/ρ_s) (GDR MiDi); and the 2-D Mohr–Coulomb
-//! mobilised friction sin φ = √(((σ_xx − σ_yy)/2)² + τ²)/p, p = (σ_xx + σ_yy)/2, with
+//! **Measured:** μ = τ/σ_n and I = γ̇ d̄/√(σ_n/ρ_s) (GDR MiDi); and the 2-D Mohr–Coulomb
+//! mobilised friction sin φ = √(((σ_xx − σ_yy)/2)² + τ²)/p, p = −(σ_xx + σ_yy)/2, with
 //! I_p = γ̇ d̄/√(p/ρ_s): the pair a plane-strain continuum uses (the biaxial test's sin φ).
 //!
 //! Integration is velocity Verlet with the contact law of [`crate::dem::contact`] (mid-step
@@ -38,6 +39,7 @@
 //! flow's own relative shift γ̇ r_c t over the cut-off r_c, exceeds the skin.
 
 use super::contact::{ContactParams, ContactState, Law, Motion};
+use super::periodic_cell::Tensor;
 
 /// The periodic cell and its grains (structure of arrays).
 pub struct Cell {
@@ -352,9 +354,8 @@ impl Cell {
         self.steps += 1;
     }
 
-    /// Stress tensor (Pa, compression positive) [xx, xy, yx, yy] with the kinetic part, and
-    /// the contacts per grain.
-    pub fn stress(&self) -> ([f64; 4], f64) {
+    /// Cauchy stress (Pa, tension positive) with the kinetic part, and the contacts per grain.
+    pub fn stress(&self) -> (Tensor, f64) {
         let v = self.ly * self.lx * self.thickness;
         let mut s = self.virial;
         for i in 0..self.len() {
@@ -366,15 +367,14 @@ impl Cell {
             s[3] += m * uy * uy;
         }
         (
-            s.map(|c| c / v),
+            -Tensor::new(s[0], s[1], s[2], s[3]) / v,
             2.0 * self.contacts as f64 / self.len() as f64,
         )
     }
 
-    /// Mean stress (σ_xx + σ_yy)/2 (Pa, compression positive).
-    pub fn mean_stress(&self) -> f64 {
-        let s = self.stress().0;
-        0.5 * (s[0] + s[3])
+    /// In-plane pressure −(σ_xx + σ_yy)/2 (Pa, compression positive).
+    pub fn pressure(&self) -> f64 {
+        -0.5 * self.stress().0.trace()
     }
 
     /// Add every grain's v_x to its bin of y/L_y (`profile[k]` = [Σ v_x, count]).
@@ -419,9 +419,9 @@ impl Cell {
         let (s, z) = self.stress();
         ShearPoint {
             strain,
-            sigma_xx: s[0],
-            sigma_yy: s[3],
-            tau: -0.5 * (s[1] + s[2]),
+            sigma_xx: -s[(0, 0)],
+            sigma_yy: -s[(1, 1)],
+            tau: 0.5 * (s[(0, 1)] + s[(1, 0)]),
             packing_fraction: self.packing_fraction(),
             coordination: z,
         }
@@ -444,7 +444,8 @@ fn min_image(dx: f64, dy: f64, lx: f64, ly: f64, offset: f64) -> (f64, f64, f64)
 pub struct ShearPoint {
     /// Shear strain γ̇ t at the end of the block.
     pub strain: f64,
-    /// σ_xx, σ_yy (Pa), τ = −½(σ_xy + σ_yx) (Pa).
+    /// Normal stresses −σ_xx, −σ_yy (Pa, compression positive) and the shear stress
+    /// τ = ½(σ_xy + σ_yx) (Pa, > 0 for γ̇ > 0), σ the tension-positive Cauchy stress.
     pub sigma_xx: f64,
     /// See `sigma_xx`.
     pub sigma_yy: f64,

@@ -95,6 +95,11 @@ pub const CASES: &[Case] = &[
         run: |f| checks_only(validation_polygon::polygons(f)),
     },
     Case {
+        name: "rve-biaxial",
+        description: "periodic volume vs wall-bounded biaxial test of one material: φ peak and critical within 2°",
+        run: |f| checks_only(super::dem::rve_biaxial::validation(f)),
+    },
+    Case {
         name: "psm-cylinder-array",
         description: "partially saturated cells: Sangani–Acrivos drag within 5 %, d ≥ 20 cells",
         run: psm::psm_cylinder_array,

@@ -182,6 +182,16 @@ impl PeriodicCell {
         self.steps
     }
 
+    /// Stop every grain (fluctuation velocities and spins to zero) and re-evaluate the forces:
+    /// a quench of the preparation, so that rattlers (grains without contacts, which nothing
+    /// slows down) come to rest.
+    pub fn stop(&mut self) {
+        self.ux.iter_mut().for_each(|u| *u = 0.0);
+        self.uy.iter_mut().for_each(|u| *u = 0.0);
+        self.w.iter_mut().for_each(|w| *w = 0.0);
+        self.forces(0.0, false);
+    }
+
     /// Replace the contact law (history kept) and re-evaluate the forces.
     pub fn set_law(&mut self, contact: &ContactParams) {
         self.law = Law::from(contact);

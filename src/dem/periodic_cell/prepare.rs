@@ -2,11 +2,17 @@
 //! isotropic confining pressure p₀.
 //!
 //! The disks (radii drawn from a seeded generator, [`SizeDistribution`]) start dilute, placed
-//! by random sequential addition at φ = 0.4 in a square cell. The cell is compressed isotropically, L = ε̇ I, by a
-//! servo on the mean pressure p = −(σ_xx + σ_yy)/2: ε̇ = −ε̇_max min(1, 4(p₀ − p)/p₀) while
-//! p < p₀ and the reverse above, with ε̇_max set by a small inertial number,
-//! ε̇_max d̄ √(ρ_s/p₀) = I_prep. A stage ends when p is within 1 % of p₀ and the fluctuation
-//! kinetic energy is below 10⁻⁴ of the stored energy.
+//! by random sequential addition at φ = 0.4 in a square cell. The cell is compressed
+//! isotropically, L = ε̇ I, by a servo on the mean pressure p = −(σ_xx + σ_yy)/2: below ½p₀
+//! (the dilute start, the jamming transition) at ε̇ = −ε̇_max, with ε̇_max set by a small
+//! inertial number, ε̇_max d̄ √(ρ_s/p₀) = I_prep; above, ε̇ = (p − p₀)/(K T) with K = k_n/t the
+//! stiffness scale of the packing and T = 1000 Δt, capped at |ε̇| ≤ ε̇_max (proportional, so it
+//! does not swing across the narrow strain window between unjammed and p₀). A stage ends when
+//! p is within 1 % of p₀ and the grains are at rest: their r.m.s. fluctuation speed below
+//! 10⁻⁴ √(p₀/ρ_s) (an inertial number of 10⁻⁴; a criterion on the kinetic over the stored
+//! energy would not do, as their ratio grows as k_n/(p₀ t) at low pressure). Within 5 % of p₀
+//! every grain is stopped every 200 steps (a quench: rattlers, grains without contacts, keep
+//! their compaction speed otherwise and the packing never counts as at rest).
 //!
 //! The packing fraction is controlled by the friction used while compacting (the usual
 //! route: frictional compaction gives loose packings, frictionless dense ones). Each
@@ -125,7 +131,9 @@ impl Preparation {
             let s = cell.stress();
             let p = -0.5 * s.trace();
             let e = cell.energy();
-            if (p - p0).abs() < 0.01 * p0 && e.kinetic < 1e-4 * e.stored {
+            // At rest: r.m.s. fluctuation speed below 10⁻⁴ √(p₀/ρ_s).
+            let mass = self.density * cell.packing_fraction() * cell.area() * self.thickness;
+            if (p - p0).abs() < 0.01 * p0 && e.kinetic < 0.5e-8 * mass * p0 / self.density {
                 return Ok(());
             }
             if cell.steps() - start > max_steps {
@@ -134,7 +142,15 @@ impl Preparation {
                      (p = {p:.4e} Pa)"
                 ));
             }
-            let eps = ((p - p0) / (stiffness * relax)).clamp(-rate, rate);
+            // Quench every 10 chunks near p₀, so rattlers stop.
+            if (p - p0).abs() < 0.05 * p0 && (cell.steps() - start).is_multiple_of(10 * chunk) {
+                cell.stop();
+            }
+            let eps = if p < 0.5 * p0 {
+                -rate
+            } else {
+                ((p - p0) / (stiffness * relax)).clamp(-rate, rate)
+            };
             cell.deform(&(eps * Tensor::identity()), chunk, self.dt)?;
         }
     }

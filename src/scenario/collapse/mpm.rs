@@ -27,12 +27,49 @@ use serde::Serialize;
 
 use super::{run_column, steps_per_row, Column, Plan, Row, Tally};
 use crate::analysis::runout::CollapseOutcome;
+use crate::coupling::RveMaterial;
+use crate::dem::periodic_cell::PeriodicCell;
 use crate::exec::Progress;
 use crate::io::{write_vti, write_vtu_points, Field, ImageGrid, PvdSeries};
-use crate::mpm::material::invariants;
+use crate::mpm::material::{invariants, Material, MaterialModel, MaterialState};
 use crate::mpm::solver::{Mpm, MpmEnergy};
-use crate::scenario::mpm::spec::MpmScenario;
-use crate::Result;
+use crate::scenario::mpm::spec::{Law, MpmScenario};
+use crate::{Error, Result};
+
+/// What a material adds to the points' VTK output: named scalar arrays of its per-point
+/// state.
+pub trait PointOutput: Material + Clone + 'static {
+    /// The arrays, one value per point.
+    fn point_scalars(states: &[Self::State]) -> Vec<(&'static str, Vec<f64>)>;
+    /// What the summary calls the solver.
+    const SOLVER: &'static str;
+}
+
+impl PointOutput for MaterialModel {
+    fn point_scalars(states: &[MaterialState]) -> Vec<(&'static str, Vec<f64>)> {
+        vec![(
+            "plastic_strain",
+            states.iter().map(|s| s.plastic_strain).collect(),
+        )]
+    }
+    const SOLVER: &'static str = "mpm";
+}
+
+/// A representative volume's packing fraction, coordination number and fabric tensor
+/// (1/N_c) Σ n ⊗ n (xx, yy, xy) at each point.
+impl PointOutput for RveMaterial {
+    fn point_scalars(states: &[PeriodicCell]) -> Vec<(&'static str, Vec<f64>)> {
+        let of = |f: &dyn Fn(&PeriodicCell) -> f64| states.iter().map(f).collect::<Vec<f64>>();
+        vec![
+            ("packing_fraction", of(&|c| c.packing_fraction())),
+            ("coordination", of(&|c| c.coordination())),
+            ("fabric_xx", of(&|c| c.fabric()[(0, 0)])),
+            ("fabric_yy", of(&|c| c.fabric()[(1, 1)])),
+            ("fabric_xy", of(&|c| c.fabric()[(0, 1)])),
+        ]
+    }
+    const SOLVER: &'static str = "mpm-rve";
+}
 
 /// What an MPM collapse run reports (`summary.json`): the solver-independent outcome (the
 /// same keys as the DEM's, so the two compare directly), the DEM's other keys where they have
@@ -79,7 +116,7 @@ fn find(parent: &mut [u32], mut a: u32) -> u32 {
 }
 
 /// Measure the deposit shape (see the module doc).
-pub fn shape(mpm: &Mpm) -> Shape {
+pub fn shape<M: Material>(mpm: &Mpm<M>) -> Shape {
     let g = &mpm.grid;
     let (nx, ny) = (g.nx, g.ny);
     let cell = |x: [f64; 2]| -> usize {
@@ -148,7 +185,12 @@ pub fn shape(mpm: &Mpm) -> Shape {
     }
 }
 
-fn write_frame(mpm: &Mpm, dir: &Path, k: usize, pvd: &mut PvdSeries) -> Result<()> {
+fn write_frame<M: PointOutput>(
+    mpm: &Mpm<M>,
+    dir: &Path,
+    k: usize,
+    pvd: &mut PvdSeries,
+) -> Result<()> {
     let p = &mpm.points;
     let n = p.len();
     let comp = |c: usize| -> Vec<f64> { p.stress.iter().map(|s| s[c]).collect() };
@@ -156,25 +198,20 @@ fn write_frame(mpm: &Mpm, dir: &Path, k: usize, pvd: &mut PvdSeries) -> Result<(
     let inv: Vec<(f64, f64)> = p.stress.iter().map(invariants).collect();
     let mean: Vec<f64> = inv.iter().map(|v| v.0).collect();
     let dev: Vec<f64> = inv.iter().map(|v| v.1).collect();
-    let eps: Vec<f64> = p.state.iter().map(|s| s.plastic_strain).collect();
+    let own = M::point_scalars(&p.state);
     let name = format!("points_{k:06}.vtu");
-    write_vtu_points(
-        &dir.join(&name),
-        &p.pos,
-        &[
-            Field::vector("velocity", &p.vel),
-            Field::scalar("stress_xx", &sxx),
-            Field::scalar("stress_yy", &syy),
-            Field::scalar("stress_xy", &sxy),
-            Field::scalar("stress_zz", &szz),
-            Field::scalar("mean_stress", &mean),
-            Field::scalar("deviatoric_stress", &dev),
-            Field::scalar("plastic_strain", &eps),
-            Field::scalar("volume", &p.vol),
-        ],
-        &[],
-        &[],
-    )?;
+    let mut fields = vec![
+        Field::vector("velocity", &p.vel),
+        Field::scalar("stress_xx", &sxx),
+        Field::scalar("stress_yy", &syy),
+        Field::scalar("stress_xy", &sxy),
+        Field::scalar("stress_zz", &szz),
+        Field::scalar("mean_stress", &mean),
+        Field::scalar("deviatoric_stress", &dev),
+    ];
+    fields.extend(own.iter().map(|(n, v)| Field::scalar(n, v)));
+    fields.push(Field::scalar("volume", &p.vol));
+    write_vtu_points(&dir.join(&name), &p.pos, &fields, &[], &[])?;
     let g = &mpm.grid;
     let mut rho = vec![0.0; g.nx * g.ny];
     let mut mv = vec![[0.0; 2]; g.nx * g.ny];
@@ -223,9 +260,9 @@ fn write_frame(mpm: &Mpm, dir: &Path, k: usize, pvd: &mut PvdSeries) -> Result<(
 }
 
 /// An MPM column: the material points released between the floor and the walls.
-pub struct MpmColumn {
+pub struct MpmColumn<M: PointOutput = MaterialModel> {
     /// The continuum.
-    pub mpm: Mpm,
+    pub mpm: Mpm<M>,
     e0: MpmEnergy,
     /// Steps per time-series row.
     series_steps: u64,
@@ -243,7 +280,7 @@ const COLUMNS: &[&str] = &[
     "budget_error",
 ];
 
-impl MpmColumn {
+impl<M: PointOutput> MpmColumn<M> {
     /// Relative energy budget error, 0 while almost nothing is dissipated (t ≈ 0, where the
     /// ratio would be round-off over round-off).
     fn budget(&self, e: &MpmEnergy) -> f64 {
@@ -256,7 +293,7 @@ impl MpmColumn {
     }
 }
 
-impl Column for MpmColumn {
+impl<M: PointOutput> Column for MpmColumn<M> {
     type Shape = MpmEnergy;
     type Summary = MpmCollapseSummary;
 
@@ -316,7 +353,7 @@ impl Column for MpmColumn {
             grains: n,
             packing_fraction: None,
             deposition_wall_time_s: 0.0,
-            solver: "mpm".into(),
+            solver: M::SOLVER.into(),
             points: n,
             cells: [self.mpm.grid.nx, self.mpm.grid.ny],
             cell_size: self.mpm.grid.h,
@@ -324,41 +361,73 @@ impl Column for MpmColumn {
     }
 }
 
-/// Build the column of `scenario`: the MPM system and the run's plan.
-pub fn column(scenario: &MpmScenario) -> Result<(MpmColumn, Plan<'_>)> {
-    let (mpm, d) = scenario.build()?;
-    let e0 = mpm.energy();
+/// The plan of the run of `scenario` for a system `mpm` (at t = 0).
+fn plan<'a, M: Material>(scenario: &'a MpmScenario, mpm: &Mpm<M>, height: f64) -> Plan<'a> {
     let ts = &scenario.time;
-    let plan = Plan {
+    Plan {
         name: &scenario.name,
         l_i: scenario.column.width,
-        h_i: d.height,
+        h_i: height,
         gravity: scenario.gravity,
-        potential: e0.potential,
+        potential: mpm.energy().potential,
         series_interval_tc: ts.series_interval_tc,
         frame_interval_tc: ts.frame_interval_tc,
         end_tc: ts.end_tc,
         rest_kinetic_fraction: ts.rest_kinetic_fraction,
         rest_duration_tc: ts.rest_duration_tc,
-    };
-    let series_steps = steps_per_row(ts.series_interval_tc, d.tau_c, mpm.dt());
-    Ok((
+    }
+}
+
+/// The column of a system `mpm` built for `scenario`.
+fn column_of<'a, M: PointOutput>(
+    scenario: &'a MpmScenario,
+    mpm: Mpm<M>,
+    height: f64,
+    tau_c: f64,
+) -> (MpmColumn<M>, Plan<'a>) {
+    let plan = plan(scenario, &mpm, height);
+    let series_steps = steps_per_row(scenario.time.series_interval_tc, tau_c, mpm.dt());
+    let e0 = mpm.energy();
+    (
         MpmColumn {
             mpm,
             e0,
             series_steps,
         },
         plan,
-    ))
+    )
+}
+
+/// Build the column of `scenario` with a closed-form law: the MPM system and the run's plan.
+pub fn column(scenario: &MpmScenario) -> Result<(MpmColumn, Plan<'_>)> {
+    let (mpm, d) = scenario.build()?;
+    Ok(column_of(scenario, mpm, d.height, d.tau_c))
 }
 
 /// Run the collapse described by `scenario`, writing into `out_dir` (created if missing).
-/// Returns the summary also written to `summary.json`.
+/// Returns the summary also written to `summary.json`. A representative-volume material is
+/// prepared first (the volume every point starts from).
 pub fn run_column_collapse(
     scenario: &MpmScenario,
     out_dir: &Path,
     progress: Progress,
 ) -> Result<MpmCollapseSummary> {
-    let (column, plan) = column(scenario)?;
-    run_column(column, &plan, out_dir, progress)
+    let d = scenario.derive()?;
+    match &d.material {
+        Law::Continuum(m) => {
+            let mpm = scenario.build_with(*m, &d)?;
+            let (column, plan) = column_of(scenario, mpm, d.height, d.tau_c);
+            run_column(column, &plan, out_dir, progress)
+        }
+        Law::Volume(prep) => {
+            let prepared = prep
+                .run()
+                .map_err(|why| Error::config("material.packing_fraction", why))?;
+            let material =
+                RveMaterial::new(prepared.cell).map_err(|why| Error::config("material", why))?;
+            let mpm = scenario.build_with(material, &d)?;
+            let (column, plan) = column_of(scenario, mpm, d.height, d.tau_c);
+            run_column(column, &plan, out_dir, progress)
+        }
+    }
 }

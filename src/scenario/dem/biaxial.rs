@@ -348,6 +348,18 @@ pub fn run_biaxial_to(
     progress: crate::exec::Progress,
 ) -> Result<BiaxialResult> {
     let r = run_biaxial(spec, progress)?;
+    write_biaxial(&r, spec.confining, spec.final_strain, out_dir)?;
+    Ok(r)
+}
+
+/// Write a test's `biaxial.csv`, `summary.json` and `biaxial.svg` into `out_dir` (the wall
+/// test's and the periodic volume's alike).
+pub fn write_biaxial(
+    r: &BiaxialResult,
+    confining: f64,
+    final_strain: f64,
+    out_dir: &Path,
+) -> Result<()> {
     std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
     let mut csv = CsvWriter::create(
         &out_dir.join("biaxial.csv"),
@@ -377,7 +389,7 @@ pub fn run_biaxial_to(
         "biaxial",
         &format!(
             "biaxial test, σ₃ = {:.0} Pa: critical φ = {:.1}°, peak {:.1}°",
-            spec.confining, r.critical_phi_deg, r.peak_phi_deg
+            confining, r.critical_phi_deg, r.peak_phi_deg
         ),
         "axial strain ε₁",
         "sin φ mobilised, volumetric strain ε_v",
@@ -393,19 +405,15 @@ pub fn run_biaxial_to(
         "ε_v (compression > 0)",
         curve(|p| p.volumetric_strain),
     ));
-    let e_end = r
-        .points
-        .last()
-        .map_or(spec.final_strain, |p| p.axial_strain);
+    let e_end = r.points.last().map_or(final_strain, |p| p.axial_strain);
     plot.series.push(Series::line(
         "critical state (mean over the second half)",
         vec![
-            (0.5 * spec.final_strain, r.critical_sin_phi),
+            (0.5 * final_strain, r.critical_sin_phi),
             (e_end, r.critical_sin_phi),
         ],
     ));
-    write_svg(&plot, &out_dir.join("biaxial.svg"))?;
-    Ok(r)
+    write_svg(&plot, &out_dir.join("biaxial.svg"))
 }
 
 /// Run the test: preparation, consolidation at σ₃, shear to `final_strain`; `progress` gets
@@ -537,37 +545,7 @@ pub fn run_biaxial(spec: &BiaxialSpec, progress: crate::exec::Progress) -> Resul
         }
     }
     let shear_time = sample.dem.time() - shear_start;
-    // Peak of the running mean over PEAK_POINTS records, so that one stick-slip spike does
-    // not set it.
-    let (peak_strain, peak_sin_phi) = points
-        .windows(PEAK_POINTS.min(points.len()).max(1))
-        .map(|w| {
-            let k = w.len() as f64;
-            (
-                w.iter().map(|p| p.axial_strain).sum::<f64>() / k,
-                w.iter().map(|p| p.sin_phi).sum::<f64>() / k,
-            )
-        })
-        .fold(
-            (f64::NAN, f64::NEG_INFINITY),
-            |a, b| if b.1 > a.1 { b } else { a },
-        );
-    let late: Vec<&BiaxialPoint> = points
-        .iter()
-        .filter(|p| p.axial_strain >= 0.5 * spec.final_strain)
-        .collect();
-    let m = late.len().max(1) as f64;
-    let mean = |f: fn(&BiaxialPoint) -> f64| late.iter().map(|p| f(p)).sum::<f64>() / m;
-    let critical_sin_phi = mean(|p| p.sin_phi);
-    let critical_sin_phi_sd = (late
-        .iter()
-        .map(|p| (p.sin_phi - critical_sin_phi).powi(2))
-        .sum::<f64>()
-        / (m - 1.0).max(1.0))
-    .sqrt();
-    let critical_packing_fraction = mean(|p| p.packing_fraction);
-    let lid = mean(|p| p.sigma_1);
-    let lid_floor_difference = (lid - mean(|p| p.sigma_1_base)) / lid;
+    let c = Curve::of(&points, spec.final_strain);
     Ok(BiaxialResult {
         grains: n,
         width: w0,
@@ -575,18 +553,83 @@ pub fn run_biaxial(spec: &BiaxialSpec, progress: crate::exec::Progress) -> Resul
         initial_packing_fraction,
         strain_rate,
         lid_speed,
-        peak_sin_phi,
-        peak_strain,
-        critical_sin_phi,
-        critical_sin_phi_sd,
-        peak_phi_deg: peak_sin_phi.asin().to_degrees(),
-        critical_phi_deg: critical_sin_phi.asin().to_degrees(),
-        critical_packing_fraction,
-        critical_sigma_3: mean(|p| p.sigma_3),
-        lid_floor_difference,
+        peak_sin_phi: c.peak_sin_phi,
+        peak_strain: c.peak_strain,
+        critical_sin_phi: c.critical_sin_phi,
+        critical_sin_phi_sd: c.critical_sin_phi_sd,
+        peak_phi_deg: c.peak_sin_phi.asin().to_degrees(),
+        critical_phi_deg: c.critical_sin_phi.asin().to_degrees(),
+        critical_packing_fraction: c.critical_packing_fraction,
+        critical_sigma_3: c.critical_sigma_3,
+        lid_floor_difference: c.lid_floor_difference,
         preparation_time: prep_time + shear_start,
         shear_time,
         steps: prep_steps + sample.dem.step_count(),
         points,
     })
+}
+
+/// What a recorded curve gives: the peak (largest running mean of sin φ over [`PEAK_POINTS`]
+/// records, so that one stick-slip spike does not set it) and the critical state (means over
+/// the second half of the axial strain).
+#[derive(Clone, Copy, Debug)]
+pub struct Curve {
+    /// Peak sin φ and the mean strain of its records.
+    pub peak_sin_phi: f64,
+    /// See `peak_sin_phi`.
+    pub peak_strain: f64,
+    /// Mean sin φ over the second half, and the standard deviation of the records about it.
+    pub critical_sin_phi: f64,
+    /// See `critical_sin_phi`.
+    pub critical_sin_phi_sd: f64,
+    /// Mean solid fraction and σ₃ over the second half.
+    pub critical_packing_fraction: f64,
+    /// See `critical_packing_fraction`.
+    pub critical_sigma_3: f64,
+    /// (mean σ₁ at the lid − at the floor)/(mean σ₁ at the lid) over the second half.
+    pub lid_floor_difference: f64,
+}
+
+impl Curve {
+    /// Read the curve of a test that ended at `final_strain`.
+    pub fn of(points: &[BiaxialPoint], final_strain: f64) -> Curve {
+        let (peak_strain, peak_sin_phi) = points
+            .windows(PEAK_POINTS.min(points.len()).max(1))
+            .map(|w| {
+                let k = w.len() as f64;
+                (
+                    w.iter().map(|p| p.axial_strain).sum::<f64>() / k,
+                    w.iter().map(|p| p.sin_phi).sum::<f64>() / k,
+                )
+            })
+            .fold(
+                (f64::NAN, f64::NEG_INFINITY),
+                |a, b| if b.1 > a.1 { b } else { a },
+            );
+        let late: Vec<&BiaxialPoint> = points
+            .iter()
+            .filter(|p| p.axial_strain >= 0.5 * final_strain)
+            .collect();
+        let m = late.len().max(1) as f64;
+        let mean = |f: fn(&BiaxialPoint) -> f64| late.iter().map(|p| f(p)).sum::<f64>() / m;
+        let critical_sin_phi = mean(|p| p.sin_phi);
+        let critical_sin_phi_sd = (late
+            .iter()
+            .map(|p| (p.sin_phi - critical_sin_phi).powi(2))
+            .sum::<f64>()
+            / (m - 1.0).max(1.0))
+        .sqrt();
+        let critical_packing_fraction = mean(|p| p.packing_fraction);
+        let lid = mean(|p| p.sigma_1);
+        let lid_floor_difference = (lid - mean(|p| p.sigma_1_base)) / lid;
+        Curve {
+            peak_sin_phi,
+            peak_strain,
+            critical_sin_phi,
+            critical_sin_phi_sd,
+            critical_packing_fraction,
+            critical_sigma_3: mean(|p| p.sigma_3),
+            lid_floor_difference,
+        }
+    }
 }

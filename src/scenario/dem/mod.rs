@@ -11,6 +11,7 @@
 
 pub mod bench;
 pub mod biaxial;
+pub mod rve_biaxial;
 pub mod shear;
 pub mod spec;
 pub mod validation;

@@ -272,7 +272,7 @@ pub fn run_shear(spec: &ShearSpec, progress: crate::exec::Progress) -> Result<Sh
     // Preparation: isotropic compression at a fixed rate until the mean stress reaches P.
     let compress = rate_of(PREP_INERTIAL_NUMBER);
     let prep_limit = 10.0 / compress;
-    while cell.mean_stress() < pressure {
+    while cell.pressure() < pressure {
         cell.step(-compress, -compress);
         let t = cell.steps as f64 * dt;
         if !cell.finite() || t > prep_limit {
@@ -297,7 +297,7 @@ pub fn run_shear(spec: &ShearSpec, progress: crate::exec::Progress) -> Result<Sh
     for rec in 0..total {
         let mut mean = ShearPoint::default();
         for _ in 0..steps_per_record {
-            let s_yy = cell.stress().0[3];
+            let s_yy = -cell.stress().0[(1, 1)];
             let rate = (BAROSTAT_GAIN * gdot * (s_yy - pressure) / pressure).clamp(-gdot, gdot);
             cell.step(0.0, rate);
             mean.add(&cell.point(0.0), 1.0 / steps_per_record as f64);

@@ -190,6 +190,15 @@ pub struct DerivedDem {
     pub time_step: TimeStep,
 }
 
+impl From<Distribution> for SizeDistribution {
+    fn from(d: Distribution) -> Self {
+        match d {
+            Distribution::Uniform => SizeDistribution::Uniform,
+            Distribution::UniformByVolume => SizeDistribution::UniformByVolume,
+        }
+    }
+}
+
 impl ScenarioFile for DemScenario {
     const KIND: Kind = Kind::Dem;
 }
@@ -294,10 +303,7 @@ impl DemScenario {
             width: c.width,
             grains: n,
             diameter: [g.d_min, g.d_max],
-            distribution: match g.distribution {
-                Distribution::Uniform => SizeDistribution::Uniform,
-                Distribution::UniformByVolume => SizeDistribution::UniformByVolume,
-            },
+            distribution: g.distribution.into(),
             density: g.density * g.thickness,
             params: dep,
             relax,

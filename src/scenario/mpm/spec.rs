@@ -17,12 +17,15 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::dem::periodic_cell::Preparation;
+use crate::dem::{DemParams, TimeStep};
 use crate::mpm::boundary::{Side, Wall, WallKind};
 use crate::mpm::grid::Grid;
 use crate::mpm::material::{LinearElastic, MaterialModel, MohrCoulomb, MuIMohrCoulomb};
 use crate::mpm::points::Points;
 use crate::mpm::shape::ShapeKind;
-use crate::mpm::solver::{cfl_step, Mpm, MpmParams, Scheme, Transfer};
+use crate::mpm::solver::{Mpm, MpmParams, Scheme, Transfer};
+use crate::scenario::dem::spec::{ContactSpec, GrainsSpec};
 use crate::scenario::{non_negative, positive, Kind, ScenarioFile};
 use crate::{Error, Result};
 
@@ -51,7 +54,7 @@ pub struct MpmScenario {
 }
 
 /// Constitutive law, chosen by `model`.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
 pub enum MaterialSpec {
     /// Linear isotropic elasticity.
@@ -109,6 +112,38 @@ pub enum MaterialSpec {
         /// Tension cut-off σ_t (Pa).
         tension_cutoff: f64,
     },
+    /// A DEM representative volume at every point ([`crate::coupling::RveMaterial`]): the
+    /// grains and contact law of a DEM material, a packing prepared once at `packing_fraction`
+    /// and `pressure` and copied to every point.
+    Rve {
+        /// Disks per volume.
+        grains: usize,
+        /// Target packing fraction φ of the prepared volume, in (0, 0.91).
+        packing_fraction: f64,
+        /// Isotropic confining pressure p₀ of the prepared volume (Pa, > 0): every point
+        /// starts at it (choose the body's mean geostatic stress).
+        pressure: f64,
+        /// Seed of the sizes and the dilute start.
+        seed: u64,
+        /// Safety factor λ of the DEM step Δt = λ Δt_cr (seed eq. 5.60).
+        lambda: f64,
+        /// Verlet skin as a fraction of the largest diameter.
+        skin_fraction: f64,
+        /// Grain sizes, density and axial length (as a DEM scenario's `[grains]`).
+        grain: GrainsSpec,
+        /// Grain–grain contact law (as a DEM scenario's `[grain_contact]`).
+        contact: ContactSpec,
+    },
+}
+
+/// The material a scenario's `[material]` gives: a closed-form law, or the preparation of the
+/// representative volume whose copies are the points' laws.
+#[derive(Clone, Debug)]
+pub enum Law {
+    /// Elastic, Mohr–Coulomb or μ(I).
+    Continuum(MaterialModel),
+    /// The DEM volume, not prepared yet (preparing takes seconds to minutes).
+    Volume(Preparation),
 }
 
 /// Column and box.
@@ -183,7 +218,7 @@ pub struct MpmTimeSpec {
 #[derive(Clone, Debug)]
 pub struct DerivedMpm {
     /// The material.
-    pub material: MaterialModel,
+    pub material: Law,
     /// H_i = a L_i (m).
     pub height: f64,
     /// τ_c = √(H_i/g) (s).
@@ -192,9 +227,10 @@ pub struct DerivedMpm {
     pub points: usize,
     /// Grid cells (x, y).
     pub cells: [usize; 2],
-    /// CFL limit C h/c (s).
+    /// CFL limit C h/c (s); for a volume, estimated before it is prepared (the run uses
+    /// the prepared packing's affine modulus).
     pub dt_cfl: f64,
-    /// P-wave speed c = √((K + 4G/3)/ρ) (m/s).
+    /// P-wave speed c = √((K + 4G/3)/ρ) (m/s); for a volume, the estimate of `dt_cfl`.
     pub wave_speed: f64,
 }
 
@@ -223,8 +259,35 @@ fn elastic(field: &str, density: f64, e: f64, nu: f64) -> Result<LinearElastic> 
 
 impl MaterialSpec {
     /// The material, with its values checked (fields named under `material.`).
-    pub fn build(&self) -> Result<MaterialModel> {
+    pub fn build(&self) -> Result<Law> {
+        Ok(match self {
+            MaterialSpec::Rve {
+                grains,
+                packing_fraction,
+                pressure,
+                seed,
+                lambda,
+                skin_fraction,
+                grain,
+                contact,
+            } => Law::Volume(volume(
+                *grains,
+                *packing_fraction,
+                *pressure,
+                *seed,
+                *lambda,
+                *skin_fraction,
+                grain,
+                contact,
+            )?),
+            m => Law::Continuum(m.continuum()?),
+        })
+    }
+
+    /// A closed-form law (not `rve`).
+    fn continuum(&self) -> Result<MaterialModel> {
         Ok(match *self {
+            MaterialSpec::Rve { .. } => unreachable!("handled by build"),
             MaterialSpec::LinearElastic {
                 density,
                 youngs_modulus,
@@ -296,6 +359,76 @@ impl MaterialSpec {
             }
         })
     }
+}
+
+/// The preparation of a representative volume, every value checked (fields named under
+/// `material.`).
+#[allow(clippy::too_many_arguments)]
+fn volume(
+    grains: usize,
+    packing_fraction: f64,
+    pressure: f64,
+    seed: u64,
+    lambda: f64,
+    skin_fraction: f64,
+    grain: &GrainsSpec,
+    contact: &ContactSpec,
+) -> Result<Preparation> {
+    if grains < 16 {
+        return Err(Error::config(
+            "material.grains",
+            format!("a representative volume needs at least 16 grains, got {grains}"),
+        ));
+    }
+    if !(packing_fraction > 0.0 && packing_fraction < 0.91) {
+        return Err(Error::config(
+            "material.packing_fraction",
+            format!("must be in (0, 0.91) (disks pack at most at 0.907), got {packing_fraction}"),
+        ));
+    }
+    positive("material.pressure", pressure)?;
+    positive("material.skin_fraction", skin_fraction)?;
+    positive("material.grain.d_min", grain.d_min)?;
+    positive("material.grain.density", grain.density)?;
+    positive("material.grain.thickness", grain.thickness)?;
+    if !(grain.d_max >= grain.d_min && grain.d_max.is_finite()) {
+        return Err(Error::config(
+            "material.grain.d_max",
+            format!("must be ≥ d_min = {}, got {}", grain.d_min, grain.d_max),
+        ));
+    }
+    let law = contact.params();
+    law.check("material.contact")?;
+    let mut params = DemParams::new(law, law, [0.0; 2]);
+    params.lambda = lambda;
+    let areal = grain.density * grain.thickness;
+    let dt = TimeStep::of_disk(&params, grain.d_min, areal)
+        .map_err(|e| e.within("material"))?
+        .dt;
+    Ok(Preparation {
+        grains,
+        diameter: [grain.d_min, grain.d_max],
+        distribution: grain.distribution.into(),
+        density: grain.density,
+        thickness: grain.thickness,
+        contact: law,
+        dt,
+        skin: skin_fraction * grain.d_max,
+        pressure,
+        packing_fraction,
+        tolerance: 0.005,
+        inertial_number: 1e-3,
+        seed,
+    })
+}
+
+/// Estimated P-wave modulus of a packing before it exists: the affine modulus of
+/// [`crate::dem::periodic_cell::PeriodicCell::affine_modulus`] for an isotropic fabric
+/// (⟨n_x⁴⟩ = 3/8, ⟨n_x² n_y²⟩ = 1/8), z = 4 contacts per grain and branch lengths d̄:
+/// C ≈ φ (3k_n + k_t)/(π t).
+fn volume_modulus(p: &Preparation) -> f64 {
+    p.packing_fraction * (3.0 * p.contact.k_n + p.contact.k_t)
+        / (std::f64::consts::PI * p.thickness)
 }
 
 /// The Mohr–Coulomb material, its angles (degrees) and strengths checked.
@@ -404,7 +537,15 @@ impl MpmScenario {
         positive("time.end_tc", t.end_tc)?;
         positive("time.rest_kinetic_fraction", t.rest_kinetic_fraction)?;
         positive("time.rest_duration_tc", t.rest_duration_tc)?;
-        let dt_cfl = cfl_step(&material, h, m.courant);
+        let (modulus, density) = match &material {
+            Law::Continuum(m) => {
+                use crate::mpm::material::Material;
+                (m.p_wave_modulus(), m.density())
+            }
+            Law::Volume(p) => (volume_modulus(p), p.density * p.packing_fraction),
+        };
+        let wave_speed = (modulus / density).sqrt();
+        let dt_cfl = m.courant * h / wave_speed;
         if let Some(dt) = t.dt {
             if dt > dt_cfl {
                 return Err(Error::config(
@@ -413,7 +554,6 @@ impl MpmScenario {
                 ));
             }
         }
-        use crate::mpm::material::Material;
         let n = m.points_per_cell;
         Ok(DerivedMpm {
             material,
@@ -422,13 +562,30 @@ impl MpmScenario {
             points: wc * hc * n * n,
             cells: [(c.box_length / h).ceil() as usize + 4, hc + 6],
             dt_cfl,
-            wave_speed: (material.p_wave_modulus() / material.density()).sqrt(),
+            wave_speed,
         })
     }
 
-    /// Build the solver at t = 0.
+    /// Build the solver at t = 0 with a closed-form law (the `rve` model is built by
+    /// [`MpmScenario::build_with`] once its volume is prepared).
     pub fn build(&self) -> Result<(Mpm, DerivedMpm)> {
         let d = self.derive()?;
+        let Law::Continuum(material) = d.material.clone() else {
+            return Err(Error::config(
+                "material.model",
+                "the rve model needs its volume prepared first (build_with)",
+            ));
+        };
+        Ok((self.build_with(material, &d)?, d))
+    }
+
+    /// Build the solver at t = 0 with `material` (every point starts from
+    /// [`crate::mpm::Material::initial_state`] at zero stress).
+    pub fn build_with<M: crate::mpm::Material>(
+        &self,
+        material: M,
+        d: &DerivedMpm,
+    ) -> Result<Mpm<M>> {
         let h = self.mpm.cell_size;
         let end = (self.column.box_length / h).ceil() * h;
         let walls = vec![
@@ -450,13 +607,12 @@ impl MpmScenario {
         ];
         let grid = Grid::new(d.cells[0], d.cells[1], h, [-2.0 * h, -2.0 * h], walls);
         let mut pts = Points::default();
-        use crate::mpm::material::Material;
         pts.fill_rect(
             [0.0, 0.0],
             [self.column.width, d.height],
             h,
             self.mpm.points_per_cell,
-            d.material.density(),
+            material.density(),
         );
         let params = MpmParams {
             shape: self.mpm.shape,
@@ -468,8 +624,9 @@ impl MpmScenario {
             pic_fraction: self.mpm.pic_fraction,
             resort_every: self.mpm.resort_every,
         };
-        let mut mpm = Mpm::new(grid, pts, d.material, params)?;
+        let mut mpm = Mpm::new(grid, pts, material, params)?;
         mpm.set_transfer(self.mpm.transfer)?;
-        Ok((mpm, d))
+        mpm.set_stress(|_| [0.0; 4])?;
+        Ok(mpm)
     }
 }

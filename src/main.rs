@@ -146,6 +146,27 @@ pub(crate) enum Collision {
 #[derive(Subcommand)]
 pub(crate) enum Bench {
     /// GIMPM step on a collapsing column, in material point-steps per second.
+    /// The MPM×DEM material: µs per point per MPM step and ns per grain per DEM sub-step of
+    /// the representative volume of an MPM scenario with `model = "rve"`.
+    Rve {
+        /// MPM scenario (TOML) with `[material] model = "rve"`.
+        scenario: PathBuf,
+        /// Points (each a copy of the prepared volume).
+        #[arg(long, default_value_t = 64)]
+        points: usize,
+        /// MPM steps per repeat.
+        #[arg(long, default_value_t = 50)]
+        steps: u64,
+        /// Threads (0: all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Timed repeats; the median is reported.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     Mpm {
         /// Material points (about; the column is w × 2w cells with 4 points per cell).
         #[arg(long, default_value_t = 8192)]

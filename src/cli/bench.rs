@@ -61,6 +61,41 @@ pub fn bench(which: Bench) -> Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
+        Bench::Rve {
+            scenario,
+            points,
+            steps,
+            threads,
+            repeats,
+            json,
+        } => {
+            use granflow::scenario::mpm::MpmScenario;
+            use granflow::scenario::ScenarioFile;
+            let s = MpmScenario::from_file(&scenario)?;
+            let r = granflow::exec::on_threads(threads, || {
+                granflow::scenario::mpm::bench_rve::run(&s, points, steps, repeats)
+            })?;
+            if json {
+                println!("{}", serde_json::to_string(&r)?);
+            } else {
+                println!(
+                    "rve {} grains × {} points, {} MPM steps ({} DEM sub-steps each) on {} threads: \
+                     {:.1} µs per point-step, {:.1} ns per grain-sub-step per core (samples {:?}); \
+                     z = {:.2}; preparation {:.1} s",
+                    r.grains,
+                    r.points,
+                    r.steps,
+                    r.substeps,
+                    r.threads,
+                    r.us_per_point_step,
+                    r.ns_per_grain_substep,
+                    r.samples,
+                    r.coordination,
+                    r.preparation_s
+                );
+            }
+            Ok(ExitCode::SUCCESS)
+        }
         Bench::Dem {
             grains,
             steps,

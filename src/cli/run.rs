@@ -177,7 +177,7 @@ fn check_mpm(path: &Path) -> Result<ExitCode> {
 
 /// Cost of one grain in one DEM sub-step of a representative volume, on one core of the 2-core
 /// machines (docs/performance.md, "MPM×DEM"), for `check`'s run-time estimate.
-const RVE_NS_PER_GRAIN_STEP: f64 = 60.0;
+const RVE_NS_PER_GRAIN_STEP: f64 = 75.0;
 
 fn run_mpm(path: &Path, out: &Path) -> Result<ExitCode> {
     let s = MpmScenario::from_file(path)?;

@@ -1,43 +1,13 @@
 use super::*;
-use crate::dem::contact::ContactParams;
-use crate::dem::packing::SizeDistribution;
-use crate::dem::periodic_cell::Preparation;
+use crate::dem::periodic_cell::tests::glass_beads;
 use crate::mpm::{Grid, Mpm, MpmParams, Points, Scheme, ShapeKind, Side, Wall, WallKind};
 
-/// One material for the tests: 64 glass-bead-like disks per unit depth at φ = 0.80, p₀ = 2 kPa.
+/// One material for the tests: 64 glass-bead-like disks per unit depth at φ = 0.80, p₀ = 2 kPa
+/// (the periodic cell's test material).
 fn material() -> RveMaterial {
     static M: std::sync::OnceLock<RveMaterial> = std::sync::OnceLock::new();
-    M.get_or_init(|| {
-        let contact = ContactParams {
-            k_n: 1e7,
-            k_t: 1e7,
-            restitution: 0.75,
-            gamma_n: 0.0,
-            gamma_t: 0.0,
-            friction: 0.5,
-            rolling_stiffness: 0.0,
-            rolling_damping: 0.0,
-            rolling_friction: 0.0,
-        };
-        let m_min = 2500.0 * std::f64::consts::PI * 0.46e-3f64.powi(2);
-        let prep = Preparation {
-            grains: 64,
-            diameter: [0.92e-3, 1.38e-3],
-            distribution: SizeDistribution::Uniform,
-            density: 2500.0,
-            thickness: 1.0,
-            contact,
-            dt: 0.2 * 2.0 * (m_min / (3.0 * contact.k_t)).sqrt(),
-            skin: 0.2e-3,
-            pressure: 2e3,
-            packing_fraction: 0.80,
-            tolerance: 0.01,
-            inertial_number: 1e-3,
-            seed: 11,
-        };
-        RveMaterial::new(prep.run().unwrap().cell).unwrap()
-    })
-    .clone()
+    M.get_or_init(|| RveMaterial::new(glass_beads(64, 0.80, 11).run().unwrap().cell).unwrap())
+        .clone()
 }
 
 fn norm(s: &Stress) -> f64 {

@@ -577,4 +577,4 @@ impl PeriodicCell {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

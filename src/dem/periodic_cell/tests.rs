@@ -2,8 +2,9 @@ use super::*;
 use crate::dem::packing::SizeDistribution;
 
 /// A glass-bead-like material per unit depth (d = 0.92–1.38 mm, ρ_s = 2500 kg/m³,
-/// k_n/p₀ ≈ 5000 at p₀ = 2 kPa), as the collapse's grains.
-fn preparation(grains: usize, phi: f64) -> Preparation {
+/// k_n/p₀ ≈ 5000 at p₀ = 2 kPa), as the collapse's grains (also the material of the
+/// representative-volume tests in `crate::coupling::rve`).
+pub(crate) fn glass_beads(grains: usize, phi: f64, seed: u64) -> Preparation {
     let contact = ContactParams {
         k_n: 1e7,
         k_t: 1e7,
@@ -31,8 +32,12 @@ fn preparation(grains: usize, phi: f64) -> Preparation {
         packing_fraction: phi,
         tolerance: 0.01,
         inertial_number: 1e-3,
-        seed: 7,
+        seed,
     }
+}
+
+fn preparation(grains: usize, phi: f64) -> Preparation {
+    glass_beads(grains, phi, 7)
 }
 
 fn norm(t: &Tensor) -> f64 {

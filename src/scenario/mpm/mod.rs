@@ -7,6 +7,7 @@
 //! The collapse itself runs in [`super::collapse`].
 
 pub mod bench;
+pub mod bench_rve;
 pub mod spec;
 pub mod validation;
 

@@ -271,6 +271,7 @@ impl MaterialSpec {
                 grain,
                 contact,
             } => Law::Volume(volume(
+                "material",
                 *grains,
                 *packing_fraction,
                 *pressure,
@@ -362,9 +363,10 @@ impl MaterialSpec {
 }
 
 /// The preparation of a representative volume, every value checked (fields named under
-/// `material.`).
+/// `table.`, e.g. `material`): the MPM's `rve` model and the periodic biaxial test.
 #[allow(clippy::too_many_arguments)]
-fn volume(
+pub(crate) fn volume(
+    table: &str,
     grains: usize,
     packing_fraction: f64,
     pressure: f64,
@@ -374,36 +376,37 @@ fn volume(
     grain: &GrainsSpec,
     contact: &ContactSpec,
 ) -> Result<Preparation> {
+    let key = |k: &str| format!("{table}.{k}");
     if grains < 16 {
         return Err(Error::config(
-            "material.grains",
+            key("grains"),
             format!("a representative volume needs at least 16 grains, got {grains}"),
         ));
     }
     if !(packing_fraction > 0.0 && packing_fraction < 0.91) {
         return Err(Error::config(
-            "material.packing_fraction",
+            key("packing_fraction"),
             format!("must be in (0, 0.91) (disks pack at most at 0.907), got {packing_fraction}"),
         ));
     }
-    positive("material.pressure", pressure)?;
-    positive("material.skin_fraction", skin_fraction)?;
-    positive("material.grain.d_min", grain.d_min)?;
-    positive("material.grain.density", grain.density)?;
-    positive("material.grain.thickness", grain.thickness)?;
+    positive(&key("pressure"), pressure)?;
+    positive(&key("skin_fraction"), skin_fraction)?;
+    positive(&key("grain.d_min"), grain.d_min)?;
+    positive(&key("grain.density"), grain.density)?;
+    positive(&key("grain.thickness"), grain.thickness)?;
     if !(grain.d_max >= grain.d_min && grain.d_max.is_finite()) {
         return Err(Error::config(
-            "material.grain.d_max",
+            key("grain.d_max"),
             format!("must be ≥ d_min = {}, got {}", grain.d_min, grain.d_max),
         ));
     }
     let law = contact.params();
-    law.check("material.contact")?;
+    law.check(&key("contact"))?;
     let mut params = DemParams::new(law, law, [0.0; 2]);
     params.lambda = lambda;
     let areal = grain.density * grain.thickness;
     let dt = TimeStep::of_disk(&params, grain.d_min, areal)
-        .map_err(|e| e.within("material"))?
+        .map_err(|e| e.within(table))?
         .dt;
     Ok(Preparation {
         grains,

@@ -397,7 +397,7 @@ fn check_reports_and_refuses_representative_volumes() {
             ["material.packing_fraction", "(0, 0.91)"],
         ),
         (
-            "pressure = 300.0",
+            "pressure = 370.0",
             "pressure = 0.0",
             ["material.pressure", "> 0"],
         ),

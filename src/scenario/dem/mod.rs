@@ -3,6 +3,8 @@
 //!
 //! * [`spec`]: the file's schema and its checks ([`DemScenario`]);
 //! * [`biaxial`]: `granflow biaxial`, the material's peak and critical-state friction angles;
+//! * [`rve_biaxial`]: the same test on a bi-periodic representative volume
+//!   (`--periodic-packing-fraction`) and the `rve-biaxial` validation case;
 //! * [`shear`]: `granflow shear`, its μ(I) by periodic simple shear;
 //! * [`bench`](mod@bench): `granflow bench dem` (the LAMMPS `in.gran2d.lmp` case);
 //! * [`validation`], [`validation_polygon`]: the DEM validation cases.

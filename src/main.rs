@@ -34,6 +34,11 @@ enum Command {
         /// Output folder (created if needed; files in it are replaced).
         #[arg(long)]
         out: PathBuf,
+        /// With every frame, write the grains of the representative volume of the material
+        /// point nearest X,Y (m) in the initial column as volume_<k>_<frame>.vtu (MPM files
+        /// with model = "rve"; repeat for more volumes).
+        #[arg(long = "rve-frames", value_name = "X,Y", value_parser = parse_place)]
+        rve_frames: Vec<[f64; 2]>,
     },
     /// Run validation cases against their references.
     Validate {
@@ -268,10 +273,27 @@ fn main() -> ExitCode {
     }
 }
 
+/// A place `X,Y` in metres.
+fn parse_place(s: &str) -> std::result::Result<[f64; 2], String> {
+    let xy: Vec<f64> = s
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| format!("`{s}`: {e}"))?;
+    match xy[..] {
+        [x, y] if x.is_finite() && y.is_finite() => Ok([x, y]),
+        _ => Err(format!("`{s}`: expected two finite numbers X,Y in metres")),
+    }
+}
+
 fn real_main() -> Result<ExitCode> {
     match Cli::parse().command {
         Command::Check { scenario } => cli::run::check(&scenario),
-        Command::Run { scenario, out } => cli::run::run(&scenario, &out),
+        Command::Run {
+            scenario,
+            out,
+            rve_frames,
+        } => cli::run::run(&scenario, &out, &rve_frames),
         Command::Validate {
             case,
             json,

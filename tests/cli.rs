@@ -380,6 +380,7 @@ fn check_reports_and_refuses_representative_volumes() {
         "80000 in all",
         "sub-steps per MPM step",
         "run time",
+        "geostatic stress (K₀ = 0.69)",
     ] {
         assert!(text.contains(e), "expected `{e}` in: {text}");
     }
@@ -401,6 +402,7 @@ fn check_reports_and_refuses_representative_volumes() {
             "pressure = 0.0",
             ["material.pressure", "> 0"],
         ),
+        ("k0 = 0.69", "k0 = 0.0", ["material.k0", "> 0"]),
     ] {
         let f = dir.path().join("bad.toml");
         assert!(base.contains(from));
@@ -411,5 +413,35 @@ fn check_reports_and_refuses_representative_volumes() {
         for e in expect {
             assert!(err.contains(e), "expected `{e}` in: {err}");
         }
+    }
+}
+
+/// `--rve-frames` is refused, naming the flag, for files whose points hold no grains and for a
+/// place that is not two numbers; nothing is written.
+#[test]
+fn rve_frames_need_a_representative_volume() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/column_collapse");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    for (file, place, expect) in [
+        ("mpm_a1.toml", "0.01,0.01", "not \"rve\""),
+        ("dem_a1.toml", "0.01,0.01", "not an MPM scenario"),
+        ("rve_a1.toml", "0.01", "two finite numbers"),
+    ] {
+        let run = granflow()
+            .arg("run")
+            .arg(root.join(file))
+            .arg("--out")
+            .arg(&out)
+            .args(["--rve-frames", place])
+            .output()
+            .unwrap();
+        assert!(!run.status.success());
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(
+            err.contains("--rve-frames") && err.contains(expect),
+            "{file}: {err}"
+        );
+        assert!(!out.exists(), "{file}: output written");
     }
 }

@@ -4,12 +4,14 @@
 //! its code in `granflow::dem::periodic_cell` and `granflow::coupling::rve`, and against the
 //! wall-bounded biaxial test in `tests/dem_biaxial.rs`.
 
-use granflow::scenario::collapse::mpm::run_column_collapse;
+use granflow::scenario::collapse::mpm::run_column_collapse_with;
 use granflow::scenario::mpm::spec::MaterialSpec;
 use granflow::scenario::mpm::MpmScenario;
 use granflow::scenario::ScenarioFile;
 
-/// `rve_a1.toml` cut down: a 4 × 4-cell column of 32-disk volumes, released for 0.3 τ_c.
+/// `rve_a1.toml` cut down: a 4 × 4-cell column of 32-disk volumes, released for 0.3 τ_c,
+/// writing the grains of one volume with each frame (`--rve-frames`); a place outside the
+/// column is refused.
 #[test]
 fn a_column_of_volumes_runs_and_writes_their_state() {
     let path =
@@ -24,7 +26,11 @@ fn a_column_of_volumes_runs_and_writes_their_state() {
     s.time.end_tc = 0.3;
     s.time.frame_interval_tc = 0.15;
     let dir = tempfile::tempdir().unwrap();
-    let r = run_column_collapse(&s, dir.path(), &mut |_, _| {}).unwrap();
+    let far = [10.0 * s.column.width, 0.0];
+    let err = run_column_collapse_with(&s, dir.path(), &[far], &mut |_, _| {}).unwrap_err();
+    assert!(err.to_string().contains("--rve-frames"), "{err}");
+    let centre = [0.5 * s.column.width, 0.5 * s.column.width];
+    let r = run_column_collapse_with(&s, dir.path(), &[centre], &mut |_, _| {}).unwrap();
     assert_eq!(r.solver, "mpm-rve");
     assert_eq!(r.points, 16);
     // The column slumps: some run-out, no point lost.
@@ -41,6 +47,15 @@ fn a_column_of_volumes_runs_and_writes_their_state() {
             "no {array} array"
         );
     }
+    // The chosen volume's 32 grains, each frame, in the series.
+    let grains = std::fs::read_to_string(dir.path().join("volume_0_000001.vtu")).unwrap();
+    assert!(grains.contains("NumberOfPoints=\"32\""), "not 32 grains");
+    assert!(grains.contains("Name=\"radius\""));
+    let series = std::fs::read_to_string(dir.path().join("series.pvd")).unwrap();
+    assert!(
+        series.contains("part=\"2\" file=\"volume_0_000000.vtu\""),
+        "{series}"
+    );
     let summary = std::fs::read_to_string(dir.path().join("summary.json")).unwrap();
     assert!(summary.contains("\"solver\": \"mpm-rve\""), "{summary}");
 }

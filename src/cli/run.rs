@@ -146,18 +146,21 @@ fn check_mpm(path: &Path) -> Result<ExitCode> {
     if let Some(dt) = s.time.dt {
         println!("dt              {dt:.4e} s (given)");
     }
-    if let Law::Volume(p) = &d.material {
+    if let Law::Volume(v) = &d.material {
+        let p = &v.preparation;
         let dt = s.time.dt.unwrap_or(d.dt_cfl);
         let sub = granflow::scale::substeps(dt, p.dt).0;
         let steps = (s.time.end_tc * d.tau_c / dt).ceil();
         let grain_steps = steps * (sub * (p.grains * d.points) as u64) as f64;
         let threads = rayon::current_num_threads() as f64;
         println!(
-            "volumes         {} grains per point, {} in all, φ = {}, p₀ = {} Pa",
+            "volumes         {} grains per point, {} in all, φ = {}, prepared at p₀ = {} Pa, \
+             each driven to its geostatic stress (K₀ = {})",
             p.grains,
             p.grains * d.points,
             p.packing_fraction,
-            p.pressure
+            p.pressure,
+            v.k0
         );
         println!(
             "DEM step        {:.4e} s: {sub} sub-steps per MPM step (the CFL step above is \
@@ -179,7 +182,7 @@ fn check_mpm(path: &Path) -> Result<ExitCode> {
 /// machines (docs/performance.md, "MPM×DEM"), for `check`'s run-time estimate.
 const RVE_NS_PER_GRAIN_STEP: f64 = 75.0;
 
-fn run_mpm(path: &Path, out: &Path) -> Result<ExitCode> {
+fn run_mpm(path: &Path, out: &Path, volumes: &[[f64; 2]]) -> Result<ExitCode> {
     let s = MpmScenario::from_file(path)?;
     let d = s.derive()?;
     eprintln!(
@@ -190,7 +193,7 @@ fn run_mpm(path: &Path, out: &Path) -> Result<ExitCode> {
     );
     let end = (1e3 * s.time.end_tc) as u64;
     let r = with_progress(end, "milli-τ_c", |p| {
-        granflow::scenario::collapse::mpm::run_column_collapse(&s, out, p)
+        granflow::scenario::collapse::mpm::run_column_collapse_with(&s, out, volumes, p)
     })
     .with_context(|| stopped(path, out))?;
     println!(
@@ -237,11 +240,21 @@ fn run_dem(path: &Path, out: &Path) -> Result<ExitCode> {
 }
 
 /// `granflow run`: run a scenario and write its outputs.
-pub fn run(path: &Path, out: &Path) -> Result<ExitCode> {
-    match kind_of_file(path)? {
+/// `granflow run`; `volumes`: the places of the representative volumes whose grains every
+/// frame writes (`--rve-frames`, MPM files with `model = "rve"` only).
+pub fn run(path: &Path, out: &Path, volumes: &[[f64; 2]]) -> Result<ExitCode> {
+    let kind = kind_of_file(path)?;
+    if !volumes.is_empty() && kind != Kind::Mpm {
+        anyhow::bail!(
+            "--rve-frames: {} is not an MPM scenario (only the points of an MPM file with \
+             model = \"rve\" hold grains)",
+            path.display()
+        );
+    }
+    match kind {
         Kind::Fluid => run_fluid(path, out),
         Kind::Dem => run_dem(path, out),
-        Kind::Mpm => run_mpm(path, out),
+        Kind::Mpm => run_mpm(path, out, volumes),
         Kind::Submerged => run_submerged(path, out),
         Kind::Sweep => anyhow::bail!(
             "{} is a sweep file: run it with `granflow sweep {} --out DIR`",

@@ -23,29 +23,34 @@
 //!
 //! **Initial state.** Every point starts from a copy of one prepared packing (a
 //! [`crate::dem::periodic_cell::Preparation`] at the target packing fraction and isotropic
-//! pressure p₀) and starts with that packing's stress, whatever stress the scenario asks for: a
-//! column is released from the isotropic state p₀ and takes its own geostatic state under
-//! gravity. Choose p₀ near the mean geostatic stress of the body.
+//! pressure p₀), driven by the preparation's [`Servo`] to the normal stresses the scenario
+//! asks of that point, (σ_xx, σ_yy) (a column's geostatic σ_yy = −ρ g (H − y), σ_xx = K₀ σ_yy),
+//! and rested there; the point starts with the stress the volume then carries (its normal
+//! stresses within 1 % of the target's mean pressure, its shear stress its own). Volumes of
+//! different points are driven in parallel. A target with tension or a shear stress beyond the
+//! servo's tolerance is refused.
 //!
 //! **Continuum constants.** The density is the packing's bulk density ρ_s φ; the P-wave modulus
 //! for the CFL step is the packing's affine (Voigt) modulus, an upper bound of its stiffness.
 
-use crate::dem::periodic_cell::{PeriodicCell, Tensor};
+use crate::dem::periodic_cell::{PeriodicCell, Servo, Target, Tensor};
 use crate::mpm::material::{Failure, Material, Strain, Stress};
 use crate::scale::substeps;
 
-/// The representative-volume material: one prepared packing, copied to every point.
+/// The representative-volume material: one prepared packing, copied to every point and
+/// driven to the point's initial stress.
 #[derive(Clone, Debug)]
 pub struct RveMaterial {
     template: PeriodicCell,
+    servo: Servo,
     density: f64,
     p_wave: f64,
 }
 
 impl RveMaterial {
-    /// The material of points that start as copies of `template`. Refuses an empty packing or
-    /// one without contacts (no stiffness).
-    pub fn new(template: PeriodicCell) -> Result<Self, String> {
+    /// The material of points that start as copies of `template`, driven to their initial
+    /// stress by `servo`. Refuses an empty packing or one without contacts (no stiffness).
+    pub fn new(template: PeriodicCell, servo: Servo) -> Result<Self, String> {
         if template.is_empty() {
             return Err("the representative volume holds no grain".into());
         }
@@ -57,7 +62,13 @@ impl RveMaterial {
             density: template.bulk_density(),
             p_wave,
             template,
+            servo,
         })
+    }
+
+    /// A point's state as prepared, with its stress: the template itself (no servo).
+    pub fn start(&self) -> (PeriodicCell, Stress) {
+        (self.template.clone(), point_stress(&self.template))
     }
 
     /// The packing every point starts from.
@@ -120,8 +131,26 @@ impl Material for RveMaterial {
         cell.energy().stored / (cell.area() * cell.thickness())
     }
 
-    fn initial_state(&self, _stress: &Stress) -> Result<(PeriodicCell, Stress), Failure> {
-        Ok((self.template.clone(), point_stress(&self.template)))
+    /// The template driven to the normal stresses of `stress` (see the module doc).
+    fn initial_state(&self, stress: &Stress) -> Result<(PeriodicCell, Stress), Failure> {
+        let [xx, yy, xy, _] = *stress;
+        if !(xx < 0.0 && yy < 0.0) {
+            return Err(format!(
+                "a representative volume starts under compression on both axes, asked for \
+                 σ_xx = {xx:e}, σ_yy = {yy:e} Pa"
+            ));
+        }
+        let pt = -0.5 * (xx + yy);
+        if xy.abs() > 0.01 * pt {
+            return Err(format!(
+                "a representative volume starts from normal stresses (the servo holds σ_xx and \
+                 σ_yy), asked for σ_xy = {xy:e} Pa beside p = {pt:e} Pa"
+            ));
+        }
+        let mut cell = self.template.clone();
+        self.servo.hold(&mut cell, Target::Normal([-xx, -yy]))?;
+        let s = point_stress(&cell);
+        Ok((cell, s))
     }
 }
 

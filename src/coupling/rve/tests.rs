@@ -6,8 +6,11 @@ use crate::mpm::{Grid, Mpm, MpmParams, Points, Scheme, ShapeKind, Side, Wall, Wa
 /// (the periodic cell's test material).
 fn material() -> RveMaterial {
     static M: std::sync::OnceLock<RveMaterial> = std::sync::OnceLock::new();
-    M.get_or_init(|| RveMaterial::new(glass_beads(64, 0.80, 11).run().unwrap().cell).unwrap())
-        .clone()
+    M.get_or_init(|| {
+        let prep = glass_beads(64, 0.80, 11);
+        RveMaterial::new(prep.run().unwrap().cell, prep.servo()).unwrap()
+    })
+    .clone()
 }
 
 fn norm(s: &Stress) -> f64 {
@@ -16,7 +19,7 @@ fn norm(s: &Stress) -> f64 {
 
 /// A point compressed along y at fixed width by `steps` increments of `de` over `dt` each.
 fn compressed(m: &RveMaterial, steps: usize, de: f64, dt: f64) -> (PeriodicCell, Stress) {
-    let (mut cell, mut s) = m.initial_state(&[0.0; 4]).unwrap();
+    let (mut cell, mut s) = m.start();
     for _ in 0..steps {
         s = m
             .update_stress(&s, &[0.0, -de, 0.0], 0.0, dt, &mut cell)
@@ -109,9 +112,12 @@ fn an_mpm_block_reproduces_the_standalone_volume() {
     };
     let grid = Grid::new(5, 5, h, [-2.0 * h, -2.0 * h], walls);
     let mut mpm = Mpm::new(grid, pts, m.clone(), params).unwrap();
-    mpm.set_stress(|_| [0.0; 4]).unwrap();
+    // The template's own normal stresses: every point starts as the template (the servo has
+    // nothing to do).
+    let s0 = point_stress(m.template());
+    mpm.set_stress(|_| [s0[0], s0[1], 0.0, s0[3]]).unwrap();
     let work0 = mpm.points.work[0];
-    let (mut alone, mut s) = m.initial_state(&[0.0; 4]).unwrap();
+    let (mut alone, mut s) = m.start();
     let e0 = alone.energy();
     let de = speed / hgt * dt;
     let steps = 60;
@@ -151,7 +157,7 @@ fn an_mpm_block_reproduces_the_standalone_volume() {
 fn a_failing_volume_names_the_reason() {
     let m = material();
     let dt = 10.0 * m.template().dt();
-    let (mut cell, s) = m.initial_state(&[0.0; 4]).unwrap();
+    let (mut cell, s) = m.start();
     // A 40 % compression in one step drives grains through each other.
     let err = m
         .update_stress(&s, &[-0.4, -0.4, 0.0], 0.0, dt, &mut cell)
@@ -162,4 +168,32 @@ fn a_failing_volume_names_the_reason() {
     );
     let mut empty = PeriodicCell::default();
     assert!(m.update_stress(&s, &[0.0; 3], 0.0, dt, &mut empty).is_err());
+}
+
+/// Initial state: a point asked for an anisotropic geostatic stress (σ_yy = −3 kPa,
+/// σ_xx = K₀ σ_yy with K₀ = 0.7, from the template at p₀ = 2 kPa) starts with its normal
+/// stresses within the servo's 1 % of the target's mean pressure, at rest; one asked for
+/// tension or shear is refused with the reason.
+#[test]
+fn a_point_starts_at_the_normal_stresses_asked() {
+    let m = material();
+    let target = [-0.7 * 3e3, -3e3, 0.0, -0.85 * 3e3];
+    let (cell, s) = m.initial_state(&target).unwrap();
+    let pt = 0.85 * 3e3;
+    for (got, want) in [(s[0], target[0]), (s[1], target[1])] {
+        assert!((got - want).abs() < 0.01 * pt, "{got} Pa for {want} Pa");
+    }
+    assert!(s[2].abs() < 0.1 * pt, "shear {s:?}");
+    let e = cell.energy();
+    assert!(e.kinetic < 1e-6 * e.stored, "not at rest: {e:?}");
+    // Unloading below the template's pressure as well.
+    let (_, s) = m.initial_state(&[-500.0, -800.0, 0.0, -650.0]).unwrap();
+    assert!(
+        (s[0] + 500.0).abs() < 6.5 && (s[1] + 800.0).abs() < 6.5,
+        "{s:?}"
+    );
+    let tension = m.initial_state(&[100.0, -3e3, 0.0, 0.0]).unwrap_err();
+    assert!(tension.contains("compression"), "{tension}");
+    let shear = m.initial_state(&[-3e3, -3e3, 500.0, -3e3]).unwrap_err();
+    assert!(shear.contains("σ_xy"), "{shear}");
 }

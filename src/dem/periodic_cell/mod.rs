@@ -36,7 +36,7 @@
 
 mod prepare;
 
-pub use prepare::{Preparation, Prepared};
+pub use prepare::{Preparation, Prepared, Servo, Target};
 
 use nalgebra::{Matrix2, Vector2};
 
@@ -289,6 +289,11 @@ impl PeriodicCell {
     /// Positions (wrapped into the cell) and radii of the grains, for output.
     pub fn grains(&self) -> impl Iterator<Item = ([f64; 2], f64)> + '_ {
         (0..self.len()).map(|i| ([self.x[i], self.y[i]], self.r[i]))
+    }
+
+    /// Fluctuation velocities u of the grains (m/s; the velocity less the affine L x).
+    pub fn fluctuation_velocities(&self) -> impl Iterator<Item = [f64; 2]> + '_ {
+        self.ux.iter().zip(&self.uy).map(|(&u, &v)| [u, v])
     }
 
     /// Take `n` steps of size `h` (≤ the cell's step) under the velocity gradient `grad`.

@@ -117,41 +117,17 @@ impl Preparation {
         ))
     }
 
-    /// Servo the cell to p₀ and rest (see the module doc).
-    fn servo(&self, cell: &mut PeriodicCell) -> Result<(), String> {
-        let p0 = self.pressure;
-        let rate = self.inertial_number / (self.mean_diameter() * (self.density / p0).sqrt());
-        // Stiffness scale of the packing, k_n/t, and the servo's relaxation time.
-        let stiffness = self.contact.k_n / self.thickness;
-        let relax = 1000.0 * self.dt;
-        let chunk = 20;
-        let max_steps = 50_000_000 / self.grains.max(1) as u64 + 2_000_000;
-        let start = cell.steps();
-        loop {
-            let s = cell.stress();
-            let p = -0.5 * s.trace();
-            let e = cell.energy();
-            // At rest: r.m.s. fluctuation speed below 10⁻⁴ √(p₀/ρ_s).
-            let mass = self.density * cell.packing_fraction() * cell.area() * self.thickness;
-            if (p - p0).abs() < 0.01 * p0 && e.kinetic < 0.5e-8 * mass * p0 / self.density {
-                return Ok(());
-            }
-            if cell.steps() - start > max_steps {
-                return Err(format!(
-                    "the packing did not settle at p₀ = {p0:e} Pa in {max_steps} steps \
-                     (p = {p:.4e} Pa)"
-                ));
-            }
-            // Quench every 10 chunks near p₀, so rattlers stop.
-            if (p - p0).abs() < 0.05 * p0 && (cell.steps() - start).is_multiple_of(10 * chunk) {
-                cell.stop();
-            }
-            let eps = if p < 0.5 * p0 {
-                -rate
-            } else {
-                ((p - p0) / (stiffness * relax)).clamp(-rate, rate)
-            };
-            cell.deform(&(eps * Tensor::identity()), chunk, self.dt)?;
+    /// The stress control of this preparation ([`Servo`]).
+    pub fn servo(&self) -> Servo {
+        Servo {
+            mean_diameter: self.mean_diameter(),
+            density: self.density,
+            thickness: self.thickness,
+            inertial_number: self.inertial_number,
+            stiffness: self.contact.k_n / self.thickness,
+            relax: 1000.0 * self.dt,
+            dt: self.dt,
+            max_steps: 50_000_000 / self.grains.max(1) as u64 + 2_000_000,
         }
     }
 
@@ -162,9 +138,10 @@ impl Preparation {
         let mut law = self.contact;
         law.friction = mu;
         cell.set_law(&law);
-        self.servo(&mut cell)?;
+        let (servo, p0) = (self.servo(), Target::Pressure(self.pressure));
+        servo.hold(&mut cell, p0)?;
         cell.set_law(&self.contact);
-        self.servo(&mut cell)?;
+        servo.hold(&mut cell, p0)?;
         Ok(cell)
     }
 
@@ -231,5 +208,87 @@ impl Preparation {
             ));
         }
         Ok(done(cell, friction, steps))
+    }
+}
+
+/// What a [`Servo`] holds (Pa, compression positive).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Target {
+    /// The mean pressure p = −½(σ_xx + σ_yy), by isotropic stretching L = ε̇ I.
+    Pressure(f64),
+    /// Each normal stress, (σ_xx, σ_yy) = −(p_x, p_y), by L = diag(ε̇_x, ε̇_y).
+    Normal([f64; 2]),
+}
+
+/// Stress control of a cell by its normal stretching rates (the module doc's servo, for the
+/// mean pressure or per axis): while the mean pressure is below half the target's, p < ½ p_t,
+/// the cell closes at ε̇_max; above, each controlled stress σ relaxes to its target σ_t by
+/// ε̇ = (σ_t − σ)/(K T), capped at |ε̇| ≤ ε̇_max, with ε̇_max d̄ √(ρ_s/p_t) = I, K = k_n/t and
+/// T = 1000 Δt. At rest when every controlled stress is within 1 % of p_t of its target and
+/// the r.m.s. fluctuation speed is below 10⁻⁴ √(p_t/ρ_s); every grain is stopped every 200
+/// steps within 5 %.
+#[derive(Clone, Copy, Debug)]
+pub struct Servo {
+    /// Mean diameter d̄ (m).
+    pub mean_diameter: f64,
+    /// Grain density ρ_s (kg/m³).
+    pub density: f64,
+    /// Axial length t of the disks (m).
+    pub thickness: f64,
+    /// Inertial number I of the largest rate.
+    pub inertial_number: f64,
+    /// Stiffness scale K = k_n/t of the packing (Pa).
+    pub stiffness: f64,
+    /// Relaxation time T of the proportional control (s).
+    pub relax: f64,
+    /// The DEM step (s).
+    pub dt: f64,
+    /// Steps after which the control gives up.
+    pub max_steps: u64,
+}
+
+impl Servo {
+    /// Drive `cell` to `target` and rest there (see the type's doc). Fails if it does not
+    /// settle within `max_steps`.
+    pub fn hold(&self, cell: &mut PeriodicCell, target: Target) -> Result<(), String> {
+        let pt = match target {
+            Target::Pressure(p) => p,
+            Target::Normal([px, py]) => 0.5 * (px + py),
+        };
+        let rate = self.inertial_number / (self.mean_diameter * (self.density / pt).sqrt());
+        let chunk = 20;
+        let start = cell.steps();
+        loop {
+            let s = cell.stress();
+            // σ_t − σ of each controlled stress, on the diagonal of the stretching.
+            let miss = match target {
+                Target::Pressure(p) => Tensor::identity() * (0.5 * s.trace() + p),
+                Target::Normal([px, py]) => Tensor::new(s[(0, 0)] + px, 0.0, 0.0, s[(1, 1)] + py),
+            };
+            let off = miss.amax();
+            let e = cell.energy();
+            let mass = self.density * cell.packing_fraction() * cell.area() * self.thickness;
+            if off < 0.01 * pt && e.kinetic < 0.5e-8 * mass * pt / self.density {
+                return Ok(());
+            }
+            if cell.steps() - start > self.max_steps {
+                return Err(format!(
+                    "the packing did not settle at {target:?} Pa in {} steps (σ_xx = {:.4e}, \
+                     σ_yy = {:.4e} Pa)",
+                    self.max_steps,
+                    s[(0, 0)],
+                    s[(1, 1)]
+                ));
+            }
+            if off < 0.05 * pt && (cell.steps() - start).is_multiple_of(10 * chunk) {
+                cell.stop();
+            }
+            let grad = if -0.5 * s.trace() < 0.5 * pt {
+                -rate * Tensor::identity()
+            } else {
+                (-miss / (self.stiffness * self.relax)).map(|e| e.clamp(-rate, rate))
+            };
+            cell.deform(&grad, chunk, self.dt)?;
+        }
     }
 }

@@ -43,6 +43,9 @@ pub trait PointOutput: Material + Clone + 'static {
     fn point_scalars(states: &[Self::State]) -> Vec<(&'static str, Vec<f64>)>;
     /// What the summary calls the solver.
     const SOLVER: &'static str;
+    /// Write the grains of one point's state as VTK points centred on `centre` (only
+    /// materials whose points hold grains can).
+    fn write_grains(state: &Self::State, centre: [f64; 2], path: &Path) -> Result<()>;
 }
 
 impl PointOutput for MaterialModel {
@@ -53,6 +56,12 @@ impl PointOutput for MaterialModel {
         )]
     }
     const SOLVER: &'static str = "mpm";
+    fn write_grains(_: &MaterialState, _: [f64; 2], path: &Path) -> Result<()> {
+        Err(Error::Other(format!(
+            "{}: a continuum point holds no grains",
+            path.display()
+        )))
+    }
 }
 
 /// A representative volume's packing fraction, coordination number and fabric tensor
@@ -69,6 +78,22 @@ impl PointOutput for RveMaterial {
         ]
     }
     const SOLVER: &'static str = "mpm-rve";
+    /// The volume's grains at their places in the cell, the cell's centre H (½, ½) moved to
+    /// `centre`, with their `radius` and `fluctuation_velocity` (the velocity less the
+    /// affine part L x).
+    fn write_grains(cell: &PeriodicCell, centre: [f64; 2], path: &Path) -> Result<()> {
+        let mid = cell.cell() * nalgebra::Vector2::new(0.5, 0.5);
+        let (pos, radius): (Vec<[f64; 2]>, Vec<f64>) = cell
+            .grains()
+            .map(|(x, r)| ([centre[0] + x[0] - mid.x, centre[1] + x[1] - mid.y], r))
+            .unzip();
+        let vel: Vec<[f64; 2]> = cell.fluctuation_velocities().collect();
+        let fields = [
+            Field::scalar("radius", &radius),
+            Field::vector("fluctuation_velocity", &vel),
+        ];
+        write_vtu_points(path, &pos, &fields, &[], &[])
+    }
 }
 
 /// What an MPM collapse run reports (`summary.json`): the solver-independent outcome (the
@@ -187,11 +212,21 @@ pub fn shape<M: Material>(mpm: &Mpm<M>) -> Shape {
 
 fn write_frame<M: PointOutput>(
     mpm: &Mpm<M>,
+    volumes: &[[f64; 2]],
     dir: &Path,
     k: usize,
     pvd: &mut PvdSeries,
 ) -> Result<()> {
     let p = &mpm.points;
+    for (v, start) in volumes.iter().enumerate() {
+        // Points are re-sorted: a point is known by its initial position.
+        let Some(q) = p.pos0.iter().position(|x| x == start) else {
+            continue;
+        };
+        let name = format!("volume_{v}_{k:06}.vtu");
+        M::write_grains(&p.state[q], p.pos[q], &dir.join(&name))?;
+        pvd.add(mpm.time(), 2 + v, &name)?;
+    }
     let n = p.len();
     let comp = |c: usize| -> Vec<f64> { p.stress.iter().map(|s| s[c]).collect() };
     let (sxx, syy, sxy, szz) = (comp(0), comp(1), comp(2), comp(3));
@@ -266,6 +301,8 @@ pub struct MpmColumn<M: PointOutput = MaterialModel> {
     e0: MpmEnergy,
     /// Steps per time-series row.
     series_steps: u64,
+    /// Initial positions of the points whose grains each frame writes.
+    volumes: Vec<[f64; 2]>,
 }
 
 /// The MPM's time-series columns after the geometry (the DEM's names where they apply).
@@ -332,7 +369,7 @@ impl<M: PointOutput> Column for MpmColumn<M> {
         _: f64,
         pvd: &mut PvdSeries,
     ) -> Result<()> {
-        write_frame(&self.mpm, dir, k, pvd)
+        write_frame(&self.mpm, &self.volumes, dir, k, pvd)
     }
     fn advance(&mut self) -> Result<()> {
         self.mpm.steps(self.series_steps)
@@ -393,6 +430,7 @@ fn column_of<'a, M: PointOutput>(
             mpm,
             e0,
             series_steps,
+            volumes: Vec::new(),
         },
         plan,
     )
@@ -412,22 +450,73 @@ pub fn run_column_collapse(
     out_dir: &Path,
     progress: Progress,
 ) -> Result<MpmCollapseSummary> {
+    run_column_collapse_with(scenario, out_dir, &[], progress)
+}
+
+/// [`run_column_collapse`], and with every frame the grains of the representative volumes of
+/// the points nearest `volumes` in the initial column (m; each within a cell of a point):
+/// `volume_<k>_<frame>.vtu`, part 2 + k of `series.pvd`, centred on the point.
+pub fn run_column_collapse_with(
+    scenario: &MpmScenario,
+    out_dir: &Path,
+    volumes: &[[f64; 2]],
+    progress: Progress,
+) -> Result<MpmCollapseSummary> {
     let d = scenario.derive()?;
     match &d.material {
         Law::Continuum(m) => {
-            let mpm = scenario.build_with(*m, &d)?;
+            if !volumes.is_empty() {
+                return Err(Error::config(
+                    "--rve-frames",
+                    "the points of this scenario hold no grains (material.model is not \"rve\")",
+                ));
+            }
+            let mpm = scenario.build_with(*m, &d, |_| [0.0; 4])?;
             let (column, plan) = column_of(scenario, mpm, d.height, d.tau_c);
             run_column(column, &plan, out_dir, progress)
         }
-        Law::Volume(prep) => {
+        Law::Volume(v) => {
+            let prep = &v.preparation;
             let prepared = prep
                 .run()
                 .map_err(|why| Error::config("material.packing_fraction", why))?;
-            let material =
-                RveMaterial::new(prepared.cell).map_err(|why| Error::config("material", why))?;
-            let mpm = scenario.build_with(material, &d)?;
-            let (column, plan) = column_of(scenario, mpm, d.height, d.tau_c);
+            let material = RveMaterial::new(prepared.cell, prep.servo())
+                .map_err(|why| Error::config("material", why))?;
+            let geostatic = scenario.geostatic(&d, material.density(), v.k0);
+            let mpm = scenario.build_with(material, &d, geostatic)?;
+            let chosen = nearest_points(&mpm, volumes)?;
+            let (mut column, plan) = column_of(scenario, mpm, d.height, d.tau_c);
+            column.volumes = chosen;
             run_column(column, &plan, out_dir, progress)
         }
     }
+}
+
+/// The initial positions of the points nearest `wanted`; refuses a place farther than a cell
+/// size from every point.
+fn nearest_points<M: Material>(mpm: &Mpm<M>, wanted: &[[f64; 2]]) -> Result<Vec<[f64; 2]>> {
+    let h = mpm.grid.h;
+    let dist2 = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
+    wanted
+        .iter()
+        .map(|&w| {
+            let best = mpm
+                .points
+                .pos0
+                .iter()
+                .copied()
+                .min_by(|a, b| dist2(*a, w).total_cmp(&dist2(*b, w)));
+            match best {
+                Some(x) if dist2(x, w) <= h * h => Ok(x),
+                _ => Err(Error::config(
+                    "--rve-frames",
+                    format!(
+                        "no material point within a cell size ({h:e} m) of ({}, {}) m in the \
+                         initial column",
+                        w[0], w[1]
+                    ),
+                )),
+            }
+        })
+        .collect()
 }

@@ -47,24 +47,26 @@ pub struct RveBench {
 /// Run the benchmark (see the module doc) on the current rayon pool.
 pub fn run(scenario: &MpmScenario, points: usize, steps: u64, repeats: usize) -> Result<RveBench> {
     let d = scenario.derive()?;
-    let Law::Volume(prep) = &d.material else {
+    let Law::Volume(volume) = &d.material else {
         return Err(Error::config(
             "material.model",
             "`granflow bench rve` needs a scenario with model = \"rve\"",
         ));
     };
+    let prep = &volume.preparation;
     let t0 = Instant::now();
     let prepared = prep
         .run()
         .map_err(|why| Error::config("material.packing_fraction", why))?;
     let preparation_s = t0.elapsed().as_secs_f64();
-    let material = RveMaterial::new(prepared.cell).map_err(|why| Error::config("material", why))?;
+    let material = RveMaterial::new(prepared.cell, prep.servo())
+        .map_err(|why| Error::config("material", why))?;
     let h = scenario.mpm.cell_size;
     let c = (material.p_wave_modulus() / material.density()).sqrt();
     let dt = scenario.time.dt.unwrap_or(scenario.mpm.courant * h / c);
     let gdot = (scenario.gravity / d.height).sqrt();
     let de = [0.0, 0.0, 0.5 * gdot * dt];
-    let (start, s0) = material.initial_state(&[0.0; 4]).map_err(Error::Other)?;
+    let (start, s0) = material.start();
     let mut samples = Vec::with_capacity(repeats);
     for _ in 0..repeats.max(1) {
         let mut cells = vec![start.clone(); points];

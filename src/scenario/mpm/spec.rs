@@ -120,9 +120,12 @@ pub enum MaterialSpec {
         grains: usize,
         /// Target packing fraction φ of the prepared volume, in (0, 0.91).
         packing_fraction: f64,
-        /// Isotropic confining pressure p₀ of the prepared volume (Pa, > 0): every point
-        /// starts at it (choose the body's mean geostatic stress).
+        /// Isotropic confining pressure p₀ of the prepared volume (Pa, > 0), from which every
+        /// point's copy is driven to its geostatic stress (choose the body's mean).
         pressure: f64,
+        /// Lateral stress ratio K₀ of the initial geostatic state, σ_xx = K₀ σ_yy with
+        /// σ_yy = −ρ g (H − y) (> 0; Jáky's K₀ = 1 − sin φ for a deposited soil).
+        k0: f64,
         /// Seed of the sizes and the dilute start.
         seed: u64,
         /// Safety factor λ of the DEM step Δt = λ Δt_cr (seed eq. 5.60).
@@ -143,7 +146,16 @@ pub enum Law {
     /// Elastic, Mohr–Coulomb or μ(I).
     Continuum(MaterialModel),
     /// The DEM volume, not prepared yet (preparing takes seconds to minutes).
-    Volume(Preparation),
+    Volume(Volume),
+}
+
+/// A representative volume to prepare, and the initial state its copies are driven to.
+#[derive(Clone, Debug)]
+pub struct Volume {
+    /// The preparation of the template packing.
+    pub preparation: Preparation,
+    /// Lateral stress ratio K₀ of the points' initial geostatic state.
+    pub k0: f64,
 }
 
 /// Column and box.
@@ -265,22 +277,29 @@ impl MaterialSpec {
                 grains,
                 packing_fraction,
                 pressure,
+                k0,
                 seed,
                 lambda,
                 skin_fraction,
                 grain,
                 contact,
-            } => Law::Volume(volume(
-                "material",
-                *grains,
-                *packing_fraction,
-                *pressure,
-                *seed,
-                *lambda,
-                *skin_fraction,
-                grain,
-                contact,
-            )?),
+            } => {
+                positive("material.k0", *k0)?;
+                Law::Volume(Volume {
+                    preparation: volume(
+                        "material",
+                        *grains,
+                        *packing_fraction,
+                        *pressure,
+                        *seed,
+                        *lambda,
+                        *skin_fraction,
+                        grain,
+                        contact,
+                    )?,
+                    k0: *k0,
+                })
+            }
             m => Law::Continuum(m.continuum()?),
         })
     }
@@ -545,7 +564,10 @@ impl MpmScenario {
                 use crate::mpm::material::Material;
                 (m.p_wave_modulus(), m.density())
             }
-            Law::Volume(p) => (volume_modulus(p), p.density * p.packing_fraction),
+            Law::Volume(v) => {
+                let p = &v.preparation;
+                (volume_modulus(p), p.density * p.packing_fraction)
+            }
         };
         let wave_speed = (modulus / density).sqrt();
         let dt_cfl = m.courant * h / wave_speed;
@@ -579,15 +601,32 @@ impl MpmScenario {
                 "the rve model needs its volume prepared first (build_with)",
             ));
         };
-        Ok((self.build_with(material, &d)?, d))
+        Ok((self.build_with(material, &d, |_| [0.0; 4])?, d))
     }
 
-    /// Build the solver at t = 0 with `material` (every point starts from
-    /// [`crate::mpm::Material::initial_state`] at zero stress).
+    /// The geostatic stress of the column at rest, σ_yy = −ρ g (H − y), σ_xx = K₀ σ_yy,
+    /// σ_zz = ½(σ_xx + σ_yy), for a bulk density ρ.
+    pub fn geostatic(
+        &self,
+        d: &DerivedMpm,
+        density: f64,
+        k0: f64,
+    ) -> impl Fn([f64; 2]) -> crate::mpm::material::Stress + Sync {
+        let (g, height) = (self.gravity, d.height);
+        move |x| {
+            let yy = -density * g * (height - x[1]);
+            [k0 * yy, yy, 0.0, 0.5 * (1.0 + k0) * yy]
+        }
+    }
+
+    /// Build the solver at t = 0 with `material`, every point starting from
+    /// [`crate::mpm::Material::initial_state`] at the stress `initial` gives at its position
+    /// (the closed-form laws start from zero stress).
     pub fn build_with<M: crate::mpm::Material>(
         &self,
         material: M,
         d: &DerivedMpm,
+        initial: impl Fn([f64; 2]) -> crate::mpm::material::Stress + Sync,
     ) -> Result<Mpm<M>> {
         let h = self.mpm.cell_size;
         let end = (self.column.box_length / h).ceil() * h;
@@ -629,7 +668,7 @@ impl MpmScenario {
         };
         let mut mpm = Mpm::new(grid, pts, material, params)?;
         mpm.set_transfer(self.mpm.transfer)?;
-        mpm.set_stress(|_| [0.0; 4])?;
+        mpm.set_stress(initial)?;
         Ok(mpm)
     }
 }

@@ -102,6 +102,8 @@ pub enum Style {
     Line,
     /// One marker per point (measurements, reference tables).
     Markers,
+    /// Points joined by a dashed line (a second kind of curve beside `Line`).
+    Dashed,
 }
 
 /// One curve or point set of a [`Plot`].
@@ -135,6 +137,14 @@ impl Series {
             points,
             style: Style::Markers,
             colour: None,
+        }
+    }
+
+    /// A dashed line through `points`.
+    pub fn dashed(label: &str, points: Vec<(f64, f64)>) -> Self {
+        Series {
+            style: Style::Dashed,
+            ..Series::line(label, points)
         }
     }
 

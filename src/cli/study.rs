@@ -34,14 +34,16 @@ pub fn sweep(path: &Path, out: &Path, jobs: usize) -> Result<ExitCode> {
             ),
         }
     }
-    for c in &r.fits.mpm_vs_dem {
-        println!(
-            "a = {:.2}: ΔL DEM {:.3}, MPM {:.3} ({:+.1} %)",
-            c.a,
-            c.dem,
-            c.mpm,
-            100.0 * c.mpm_excess
-        );
+    for (name, list) in [("MPM", &r.fits.mpm_vs_dem), ("MPM×DEM", &r.fits.rve_vs_dem)] {
+        for c in list {
+            println!(
+                "a = {:.2}: ΔL DEM {:.3}, {name} {:.3} ({:+.1} %)",
+                c.a,
+                c.dem,
+                c.mpm,
+                100.0 * c.mpm_excess
+            );
+        }
     }
     let failed: Vec<_> = r.failed().collect();
     println!(

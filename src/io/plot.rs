@@ -401,6 +401,22 @@ fn draw(
                         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
                 }
             }
+            Style::Dashed => {
+                let line = colour.stroke_width(2);
+                let drawn = chart
+                    .draw_series(DashedLineSeries::new(pts.iter().copied(), 7, 5, line))
+                    .map_err(|e| err(&e))?;
+                if !s.label.is_empty() {
+                    drawn.label(s.label.as_str()).legend(move |(x, y)| {
+                        plotters::element::DashedPathElement::new(
+                            vec![(x, y), (x + 20, y)],
+                            7,
+                            5,
+                            line,
+                        )
+                    });
+                }
+            }
             Style::Markers => {
                 // Shapes differ between marker series so that coinciding points stay visible.
                 // 0: filled circle, 1: open square, 2: cross, 3: open triangle.
@@ -443,4 +459,27 @@ fn draw(
         .draw()
         .map_err(|e| err(&e))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::Series;
+
+    /// A dashed line is drawn as dashes: many more strokes than the one polyline of the same
+    /// curve drawn solid.
+    #[test]
+    fn a_dashed_line_is_drawn_in_dashes() {
+        let pts = vec![(0.0, 0.0), (1.0, 1.0)];
+        let strokes = |s: Series| {
+            let mut plot = Plot::new("t", "t", "x", "y");
+            plot.series.push(s);
+            render_svg(&plot).unwrap().matches("<polyline").count()
+        };
+        let (solid, dashed) = (
+            strokes(Series::line("", pts.clone())),
+            strokes(Series::dashed("", pts)),
+        );
+        assert!(dashed > solid + 10, "solid {solid}, dashed {dashed} strokes");
+    }
 }

@@ -4,8 +4,8 @@
 //!    reference laws (Lajeunesse et al. 2005; the thesis's DEM);
 //! 2. `height`: H_f/L_i against a (log–log), with H_f/L_i = a (a ≲ 0.7) and the weaker
 //!    a^(1/3) quoted for experiments (drawn from a = 0.7 on, continuous there);
-//! 3. `front`: (L − L_i)/L_i against t/τ_c for every case, DEM lines and MPM markers in one
-//!    colour per aspect ratio (only the DEM lines have legend entries);
+//! 3. `front`: (L − L_i)/L_i against t/τ_c for every case, DEM lines, MPM markers and MPM×DEM
+//!    dashed lines in one colour per aspect ratio (the DEM lines name the aspect ratio);
 //! 4. `energy_<case>`: the energy budget against t/τ_c (potential released, kinetic,
 //!    dissipated by collisions, friction, rolling resistance and plastic flow), as fractions of
 //!    the potential energy released by the end, for each solver's shortest and tallest column.
@@ -155,7 +155,7 @@ fn fronts(dir: &Path, cases: &[CaseResult]) -> Result<()> {
         .collect();
     let mut plot = Plot::new(
         "front",
-        "Run-out against time: DEM lines, MPM markers, one colour per a",
+        "Run-out against time: DEM lines, MPM markers, MPM×DEM dashed, one colour per a",
         "t/τ_c",
         "(L − L_i)/L_i",
     );
@@ -178,6 +178,8 @@ fn fronts(dir: &Path, cases: &[CaseResult]) -> Result<()> {
                 // Unlabelled where the DEM line of the same colour names the aspect ratio.
                 Solver::Mpm if dem_a.contains(&a) => Series::markers("", pts).decimated(40),
                 Solver::Mpm => Series::markers(&format!("MPM {name}"), pts).decimated(40),
+                Solver::Rve if dem_a.contains(&a) => Series::dashed("", pts).decimated(400),
+                Solver::Rve => Series::dashed(&format!("MPM×DEM {name}"), pts).decimated(400),
             }
             .coloured(colour),
         );
@@ -239,7 +241,7 @@ fn energy(dir: &Path, c: &CaseResult, o: &CollapseOutcome) -> Result<()> {
 
 /// Figure 4: each solver's shortest and tallest column (of the first group).
 fn energies(dir: &Path, cases: &[CaseResult]) -> Result<()> {
-    for solver in [Solver::Dem, Solver::Mpm] {
+    for solver in Solver::ALL {
         let mine: Vec<(&CaseResult, &CollapseOutcome)> = cases
             .iter()
             .filter(|c| c.case.solver == solver)

@@ -88,7 +88,7 @@ fn run_case(case: &Case, dir: &Path, progress: crate::exec::Progress) -> Result<
             let s = crate::scenario::dem::DemScenario::from_toml(&case.scenario)?;
             crate::scenario::collapse::dem::run_column_collapse(&s, dir, progress)?.collapse
         }
-        Solver::Mpm => {
+        Solver::Mpm | Solver::Rve => {
             let s = crate::scenario::mpm::MpmScenario::from_toml(&case.scenario)?;
             crate::scenario::collapse::mpm::run_column_collapse(&s, dir, progress)?.collapse
         }
@@ -114,9 +114,20 @@ pub fn run_sweep(path: &Path, out: &Path, jobs: usize) -> Result<SweepReport> {
             Solver::Dem => crate::scenario::dem::DemScenario::from_toml(&case.scenario)?
                 .derive()
                 .map(|_| ()),
-            Solver::Mpm => crate::scenario::mpm::MpmScenario::from_toml(&case.scenario)?
+            solver => crate::scenario::mpm::MpmScenario::from_toml(&case.scenario)?
                 .derive()
-                .map(|_| ()),
+                .and_then(|d| {
+                    let rve = matches!(d.material, crate::scenario::mpm::spec::Law::Volume(_));
+                    if rve == (solver == Solver::Rve) {
+                        Ok(())
+                    } else {
+                        Err(Error::config(
+                            "material.model",
+                            "the `rve` solver takes MPM files with model = \"rve\", the `mpm` \
+                             solver the others",
+                        ))
+                    }
+                }),
         }
         .map_err(|e| Error::Other(format!("case `{}`: {e}", case.name)))?;
     }

@@ -44,14 +44,21 @@ pub enum Solver {
     Dem,
     /// The MPM column collapse (`mpm::run`).
     Mpm,
+    /// The MPM column collapse with a DEM representative volume at every point (an MPM file
+    /// with `material.model = "rve"`).
+    Rve,
 }
 
 impl Solver {
-    /// `"dem"` or `"mpm"`.
+    /// Every solver, in case order.
+    pub const ALL: [Solver; 3] = [Solver::Dem, Solver::Mpm, Solver::Rve];
+
+    /// `"dem"`, `"mpm"` or `"rve"`.
     pub fn name(self) -> &'static str {
         match self {
             Solver::Dem => "dem",
             Solver::Mpm => "mpm",
+            Solver::Rve => "rve",
         }
     }
 }
@@ -106,7 +113,7 @@ fn err(field: impl Into<String>, reason: impl Into<String>) -> Error {
 
 /// Splits `key` into (solver it is limited to, path in the scenario).
 fn split(key: &str) -> (Option<Solver>, &str) {
-    for s in [Solver::Dem, Solver::Mpm] {
+    for s in Solver::ALL {
         if let Some(rest) = key.strip_prefix(s.name()).and_then(|r| r.strip_prefix('.')) {
             return (Some(s), rest);
         }
@@ -172,7 +179,10 @@ fn show(v: &Value) -> String {
 /// Expands `spec` into its cases; base paths are relative to `dir`.
 pub fn expand(spec: &SweepSpec, dir: &Path) -> Result<Vec<Case>> {
     if spec.solvers.is_empty() {
-        return Err(err("solvers", "name at least one base scenario (dem, mpm)"));
+        return Err(err(
+            "solvers",
+            "name at least one base scenario (dem, mpm, rve)",
+        ));
     }
     if spec.vary.is_empty() {
         return Err(err("vary", "give at least one [[vary]] table"));

@@ -61,7 +61,7 @@ pub const REFERENCE_LAWS: [ReferenceLaw; 2] = [
 /// run-out law.
 #[derive(Clone, Debug, Serialize)]
 pub struct GroupFit {
-    /// `"dem"` or `"mpm"`.
+    /// `"dem"`, `"mpm"` or `"rve"`.
     pub solver: &'static str,
     /// The other varied values of the group (path → value).
     pub with: BTreeMap<String, String>,
@@ -73,19 +73,19 @@ pub struct GroupFit {
     pub law: Option<RunoutLaw>,
 }
 
-/// MPM against DEM for one set of varied values (the same nominal aspect ratio; the DEM's
-/// deposited column is a little taller than nominal).
+/// A continuum (MPM, or MPM×DEM) against the DEM for one set of varied values (the same
+/// nominal aspect ratio; the DEM's deposited column is a little taller than nominal).
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct Comparison {
     /// Aspect ratio of the DEM case (as deposited).
     pub a: f64,
-    /// Aspect ratio of the MPM case.
+    /// Aspect ratio of the continuum case.
     pub a_mpm: f64,
     /// ΔL of the DEM.
     pub dem: f64,
-    /// ΔL of the MPM.
+    /// ΔL of the continuum.
     pub mpm: f64,
-    /// ΔL_MPM/ΔL_DEM − 1.
+    /// ΔL_continuum/ΔL_DEM − 1.
     pub mpm_excess: f64,
 }
 
@@ -105,6 +105,8 @@ pub struct Fits {
     pub groups: Vec<GroupFit>,
     /// MPM vs DEM case by case.
     pub mpm_vs_dem: Vec<Comparison>,
+    /// MPM×DEM (`rve`) vs DEM case by case.
+    pub rve_vs_dem: Vec<Comparison>,
     /// The published laws drawn beside them.
     pub references: [ReferenceLaw; 2],
     /// Cases that failed (left out of the fits).
@@ -154,29 +156,40 @@ pub fn fits(cases: &[CaseResult]) -> Fits {
             }
         })
         .collect();
-    // MPM against DEM: cases with the same varied values (aspect ratio included).
-    let mut mpm_vs_dem = Vec::new();
+    let (mpm_vs_dem, rve_vs_dem) = (
+        versus_dem(cases, Solver::Mpm),
+        versus_dem(cases, Solver::Rve),
+    );
+    Fits {
+        groups,
+        mpm_vs_dem,
+        rve_vs_dem,
+        references: REFERENCE_LAWS,
+        failed,
+    }
+}
+
+/// The cases of `solver` against the DEM's with the same varied values (aspect ratio
+/// included).
+fn versus_dem(cases: &[CaseResult], solver: Solver) -> Vec<Comparison> {
     let done = |c: &CaseResult| c.outcome.as_ref().ok().cloned();
-    for d in cases.iter().filter(|c| c.case.solver == Solver::Dem) {
-        let twin = cases
-            .iter()
-            .find(|m| m.case.solver == Solver::Mpm && m.case.labels == d.case.labels);
-        if let (Some(od), Some(om)) = (done(d), twin.and_then(done)) {
-            mpm_vs_dem.push(Comparison {
+    cases
+        .iter()
+        .filter(|c| c.case.solver == Solver::Dem)
+        .filter_map(|d| {
+            let twin = cases
+                .iter()
+                .find(|m| m.case.solver == solver && m.case.labels == d.case.labels);
+            let (od, om) = (done(d)?, twin.and_then(done)?);
+            Some(Comparison {
                 a: od.aspect_ratio,
                 a_mpm: om.aspect_ratio,
                 dem: od.delta_l,
                 mpm: om.delta_l,
                 mpm_excess: om.delta_l / od.delta_l - 1.0,
-            });
-        }
-    }
-    Fits {
-        groups,
-        mpm_vs_dem,
-        references: REFERENCE_LAWS,
-        failed,
-    }
+            })
+        })
+        .collect()
 }
 
 /// Header of `sweep.csv` after the varied paths.

@@ -169,7 +169,9 @@ fn check_mpm(path: &Path) -> Result<ExitCode> {
         );
         println!(
             "run time        at most {:.0} s on {threads} threads to end_tc ({:.2e} grain-steps \
-             at {RVE_NS_PER_GRAIN_STEP} ns each, measured; a run at rest stops earlier)",
+             at {RVE_NS_PER_GRAIN_STEP} ns each, measured; a run at rest stops earlier), after \
+             preparing the volume and driving the points' copies to their stresses (not \
+             bounded: seconds to minutes)",
             grain_steps * RVE_NS_PER_GRAIN_STEP * 1e-9 / threads,
             grain_steps
         );
@@ -239,8 +241,7 @@ fn run_dem(path: &Path, out: &Path) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// `granflow run`: run a scenario and write its outputs.
-/// `granflow run`; `volumes`: the places of the representative volumes whose grains every
+/// `granflow run`: run a scenario and write its outputs; `volumes`: the places of the representative volumes whose grains every
 /// frame writes (`--rve-frames`, MPM files with `model = "rve"` only).
 pub fn run(path: &Path, out: &Path, volumes: &[[f64; 2]]) -> Result<ExitCode> {
     let kind = kind_of_file(path)?;

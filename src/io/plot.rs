@@ -480,6 +480,9 @@ mod tests {
             strokes(Series::line("", pts.clone())),
             strokes(Series::dashed("", pts)),
         );
-        assert!(dashed > solid + 10, "solid {solid}, dashed {dashed} strokes");
+        assert!(
+            dashed > solid + 10,
+            "solid {solid}, dashed {dashed} strokes"
+        );
     }
 }

@@ -33,7 +33,11 @@ fn write(dir: &Path, plot: &Plot) -> Result<()> {
 }
 
 fn label(solver: &str, with: &std::collections::BTreeMap<String, String>) -> String {
-    let mut s = solver.to_uppercase();
+    let mut s = if solver == Solver::Rve.name() {
+        "MPM×DEM".to_owned()
+    } else {
+        solver.to_uppercase()
+    };
     for (p, v) in with {
         s.push_str(&format!(" {}={v}", p.rsplit('.').next().unwrap_or(p)));
     }

@@ -33,7 +33,7 @@
 //! **Continuum constants.** The density is the packing's bulk density ρ_s φ; the P-wave modulus
 //! for the CFL step is the packing's affine (Voigt) modulus, an upper bound of its stiffness.
 
-use crate::dem::periodic_cell::{PeriodicCell, Servo, Target, Tensor};
+use crate::dem::periodic_cell::{PeriodicCell, Preparation, Servo, Target, Tensor};
 use crate::mpm::material::{Failure, Material, Strain, Stress};
 use crate::scale::substeps;
 
@@ -64,6 +64,11 @@ impl RveMaterial {
             template,
             servo,
         })
+    }
+
+    /// Prepare the packing of `prep` and make it the material, with `prep`'s servo.
+    pub fn prepare(prep: &Preparation) -> Result<Self, String> {
+        RveMaterial::new(prep.run()?.cell, prep.servo())
     }
 
     /// A point's state as prepared, with its stress: the template itself (no servo).
@@ -148,7 +153,9 @@ impl Material for RveMaterial {
             ));
         }
         let mut cell = self.template.clone();
-        self.servo.hold(&mut cell, Target::Normal([-xx, -yy]))?;
+        self.servo
+            .hold(&mut cell, Target::Normal([-xx, -yy]))
+            .map_err(|why| format!("its representative volume: {why}"))?;
         let s = point_stress(&cell);
         Ok((cell, s))
     }

@@ -6,11 +6,8 @@ use crate::mpm::{Grid, Mpm, MpmParams, Points, Scheme, ShapeKind, Side, Wall, Wa
 /// (the periodic cell's test material).
 fn material() -> RveMaterial {
     static M: std::sync::OnceLock<RveMaterial> = std::sync::OnceLock::new();
-    M.get_or_init(|| {
-        let prep = glass_beads(64, 0.80, 11);
-        RveMaterial::new(prep.run().unwrap().cell, prep.servo()).unwrap()
-    })
-    .clone()
+    M.get_or_init(|| RveMaterial::prepare(&glass_beads(64, 0.80, 11)).unwrap())
+        .clone()
 }
 
 fn norm(s: &Stress) -> f64 {
@@ -116,6 +113,11 @@ fn an_mpm_block_reproduces_the_standalone_volume() {
     // nothing to do).
     let s0 = point_stress(m.template());
     mpm.set_stress(|_| [s0[0], s0[1], 0.0, s0[3]]).unwrap();
+    assert_eq!(
+        mpm.state(0).steps(),
+        m.template().steps(),
+        "the servo moved the template"
+    );
     let work0 = mpm.points.work[0];
     let (mut alone, mut s) = m.start();
     let e0 = alone.energy();

@@ -248,19 +248,32 @@ pub struct Servo {
 }
 
 impl Servo {
-    /// Drive `cell` to `target` and rest there (see the type's doc). Fails if it does not
-    /// settle within `max_steps`.
+    /// Drive `cell` to `target` and rest there (see the type's doc). Refuses a target that is
+    /// not a finite compression; fails if the cell does not settle within `max_steps`.
     pub fn hold(&self, cell: &mut PeriodicCell, target: Target) -> Result<(), String> {
-        let pt = match target {
-            Target::Pressure(p) => p,
-            Target::Normal([px, py]) => 0.5 * (px + py),
+        let (pt, shown) = match target {
+            Target::Pressure(p) => (p, format!("p = {p:e} Pa")),
+            Target::Normal([px, py]) => (
+                if px.min(py) > 0.0 {
+                    0.5 * (px + py)
+                } else {
+                    f64::NAN
+                },
+                format!("σ_xx = {:e} Pa, σ_yy = {:e} Pa", -px, -py),
+            ),
         };
+        if !(pt.is_finite() && pt > 0.0) {
+            return Err(format!(
+                "a packing is held only under compression, asked for {shown}"
+            ));
+        }
         let rate = self.inertial_number / (self.mean_diameter * (self.density / pt).sqrt());
         let chunk = 20;
         let start = cell.steps();
         loop {
             let s = cell.stress();
-            // σ_t − σ of each controlled stress, on the diagonal of the stretching.
+            // σ − σ_t of each controlled stress, on the diagonal (the stretching is its
+            // opposite over K T).
             let miss = match target {
                 Target::Pressure(p) => Tensor::identity() * (0.5 * s.trace() + p),
                 Target::Normal([px, py]) => Tensor::new(s[(0, 0)] + px, 0.0, 0.0, s[(1, 1)] + py),
@@ -273,8 +286,8 @@ impl Servo {
             }
             if cell.steps() - start > self.max_steps {
                 return Err(format!(
-                    "the packing did not settle at {target:?} Pa in {} steps (σ_xx = {:.4e}, \
-                     σ_yy = {:.4e} Pa)",
+                    "the packing did not settle at {shown} in {} steps (σ_xx = {:.4e}, σ_yy = \
+                     {:.4e} Pa)",
                     self.max_steps,
                     s[(0, 0)],
                     s[(1, 1)]

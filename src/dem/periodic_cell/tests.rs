@@ -228,3 +228,20 @@ fn another_basis_of_the_same_lattice_gives_the_same_forces() {
     c.forces(0.0, false);
     assert!(norm(&(c.stress() - s0)) < 1e-10 * norm(&s0));
 }
+
+/// The servo holds only a compression: a zero pressure, a tension on one axis or a
+/// non-finite target is refused at once, without a step.
+#[test]
+fn the_servo_refuses_what_it_cannot_hold() {
+    let prep = preparation(32, 0.8);
+    let mut cell = prep.dilute().unwrap();
+    for target in [
+        Target::Pressure(0.0),
+        Target::Pressure(f64::NAN),
+        Target::Normal([-100.0, 500.0]),
+    ] {
+        let err = prep.servo().hold(&mut cell, target).unwrap_err();
+        assert!(err.contains("only under compression"), "{target:?}: {err}");
+    }
+    assert_eq!(cell.steps(), 0);
+}

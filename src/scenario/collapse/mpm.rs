@@ -4,7 +4,10 @@
 //! * `series.pvd` with, per frame, `points_NNNNNN.vtu` (part 0: material points with velocity,
 //!   stress components, mean stress p = tr σ/3, deviatoric (von Mises) stress q = √(3J₂),
 //!   equivalent plastic strain, volume) and `grid_NNNNNN.vti` (part 1: per cell the mass
-//!   density and mean velocity of the points in it);
+//!   density and mean velocity of the points in it); with a representative-volume material
+//!   the points also carry each volume's packing fraction, coordination and fabric, and
+//!   `volume_<k>_NNNNNN.vtu` (part 2 + k) the grains of the volumes chosen with
+//!   [`run_column_collapse_with`];
 //! * `timeseries.csv`: t, t/τ_c, run-out, front, height, energies, budget error (the DEM's
 //!   column names where they apply);
 //! * `summary.json` ([`MpmCollapseSummary`], the DEM's `CollapseSummary` keys plus MPM ones).
@@ -466,9 +469,10 @@ pub fn run_column_collapse_with(
     match &d.material {
         Law::Continuum(m) => {
             if !volumes.is_empty() {
-                return Err(Error::config(
-                    "--rve-frames",
-                    "the points of this scenario hold no grains (material.model is not \"rve\")",
+                return Err(Error::Other(
+                    "--rve-frames: the points of this scenario hold no grains (material.model \
+                     is not \"rve\")"
+                        .into(),
                 ));
             }
             let mpm = scenario.build_with(*m, &d, |_| [0.0; 4])?;
@@ -476,12 +480,13 @@ pub fn run_column_collapse_with(
             run_column(column, &plan, out_dir, progress)
         }
         Law::Volume(v) => {
-            let prep = &v.preparation;
-            let prepared = prep
-                .run()
-                .map_err(|why| Error::config("material.packing_fraction", why))?;
-            let material = RveMaterial::new(prepared.cell, prep.servo())
-                .map_err(|why| Error::config("material", why))?;
+            check_places(
+                volumes,
+                scenario.column.width,
+                d.height,
+                scenario.mpm.cell_size,
+            )?;
+            let material = v.material()?;
             let geostatic = scenario.geostatic(&d, material.density(), v.k0);
             let mpm = scenario.build_with(material, &d, geostatic)?;
             let chosen = nearest_points(&mpm, volumes)?;
@@ -489,6 +494,21 @@ pub fn run_column_collapse_with(
             column.volumes = chosen;
             run_column(column, &plan, out_dir, progress)
         }
+    }
+}
+
+/// Refuses, before anything is prepared, a place outside the initial column `width` × `height`
+/// widened by a cell size `h`.
+fn check_places(wanted: &[[f64; 2]], width: f64, height: f64, h: f64) -> Result<()> {
+    match wanted
+        .iter()
+        .find(|w| !((-h..=width + h).contains(&w[0]) && (-h..=height + h).contains(&w[1])))
+    {
+        Some(w) => Err(Error::Other(format!(
+            "--rve-frames: ({}, {}) m is outside the initial column (0–{width} m × 0–{height} m)",
+            w[0], w[1]
+        ))),
+        None => Ok(()),
     }
 }
 
@@ -508,14 +528,11 @@ fn nearest_points<M: Material>(mpm: &Mpm<M>, wanted: &[[f64; 2]]) -> Result<Vec<
                 .min_by(|a, b| dist2(*a, w).total_cmp(&dist2(*b, w)));
             match best {
                 Some(x) if dist2(x, w) <= h * h => Ok(x),
-                _ => Err(Error::config(
-                    "--rve-frames",
-                    format!(
-                        "no material point within a cell size ({h:e} m) of ({}, {}) m in the \
-                         initial column",
-                        w[0], w[1]
-                    ),
-                )),
+                _ => Err(Error::Other(format!(
+                    "--rve-frames: no material point within a cell size ({h:e} m) of ({}, {}) m \
+                     in the initial column",
+                    w[0], w[1]
+                ))),
             }
         })
         .collect()

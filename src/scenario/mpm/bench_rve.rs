@@ -13,7 +13,6 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::coupling::RveMaterial;
 use crate::mpm::material::Material;
 use crate::scenario::mpm::spec::{Law, MpmScenario};
 use crate::{Error, Result};
@@ -53,14 +52,9 @@ pub fn run(scenario: &MpmScenario, points: usize, steps: u64, repeats: usize) ->
             "`granflow bench rve` needs a scenario with model = \"rve\"",
         ));
     };
-    let prep = &volume.preparation;
     let t0 = Instant::now();
-    let prepared = prep
-        .run()
-        .map_err(|why| Error::config("material.packing_fraction", why))?;
+    let material = volume.material()?;
     let preparation_s = t0.elapsed().as_secs_f64();
-    let material = RveMaterial::new(prepared.cell, prep.servo())
-        .map_err(|why| Error::config("material", why))?;
     let h = scenario.mpm.cell_size;
     let c = (material.p_wave_modulus() / material.density()).sqrt();
     let dt = scenario.time.dt.unwrap_or(scenario.mpm.courant * h / c);

@@ -114,7 +114,8 @@ pub enum MaterialSpec {
     },
     /// A DEM representative volume at every point ([`crate::coupling::RveMaterial`]): the
     /// grains and contact law of a DEM material, a packing prepared once at `packing_fraction`
-    /// and `pressure` and copied to every point.
+    /// and `pressure`, copied to every point and driven there to the geostatic stress with
+    /// lateral ratio `k0`.
     Rve {
         /// Disks per volume.
         grains: usize,
@@ -156,6 +157,15 @@ pub struct Volume {
     pub preparation: Preparation,
     /// Lateral stress ratio K₀ of the points' initial geostatic state.
     pub k0: f64,
+}
+
+impl Volume {
+    /// Prepare the packing (seconds to minutes): the material of the points. A packing the
+    /// preparation cannot make is refused naming `material.packing_fraction`.
+    pub fn material(&self) -> Result<crate::coupling::RveMaterial> {
+        crate::coupling::RveMaterial::prepare(&self.preparation)
+            .map_err(|why| Error::config("material.packing_fraction", why))
+    }
 }
 
 /// Column and box.

@@ -1,4 +1,4 @@
-//! `granflow bench dem`: the case of `../shared/peers/in.gran2d.lmp`, so granflow and LAMMPS's
+//! `granflow bench dem`: the LAMMPS peer case `in.gran2d.lmp` (docs/performance.md), so granflow and LAMMPS's
 //! `gran/hooke/history` are timed on the same run.
 //!
 //! Reduced (LJ) units: a hex-packed block of ≈ N disks (√N × √N, nearest-neighbour spacing 1),

@@ -8,7 +8,7 @@
 //! the stream function ψ(x, y) = ∫₀^y u dy', located to sub-cell accuracy by a quadratic fit
 //! over the 3×3 cells around the discrete minimum.
 //!
-//! Gates (the issue; REFERENCES.md): max |Δu|, |Δv| ≤ 0.02 U on the centre lines, and the vortex
+//! Gates (the issue; docs/validation.md): max |Δu|, |Δv| ≤ 0.02 U on the centre lines, and the vortex
 //! centre within 0.02 L of Ghia's.
 
 use crate::lbm::{Lbm, Macroscopic};
@@ -22,12 +22,12 @@ use crate::Result;
 /// remaining drift is then ≲ 1e-4 U,
 /// two orders below the 0.02 gate.
 const STEADY_TOL: f64 = 1e-5;
-/// Issue / REFERENCES.md: max |Δu|, |Δv| ≤ 0.02 U_lid.
+/// Issue / docs/validation.md: max |Δu|, |Δv| ≤ 0.02 U_lid.
 const VELOCITY_TOL: f64 = 0.02;
 /// Issue: primary vortex centre within 0.02 of the side.
 const CENTRE_TOL: f64 = 0.02;
 
-/// Ghia, Ghia & Shin (1982), Tables I and II (REFERENCES.md): u(0.5, y) and v(x, 0.5), U = 1.
+/// Ghia, Ghia & Shin (1982), Tables I and II (docs/validation.md): u(0.5, y) and v(x, 0.5), U = 1.
 struct Ghia {
     /// Reynolds number.
     re: u32,

@@ -211,7 +211,7 @@ pub fn run_2d1(fidelity: Fidelity) -> Result<Report> {
         // Gate of the issue: 2 % at D ≥ 40 cells (published interval ±0.2 %).
         Check::rel(case, "pressure difference Δp (Pa)", m.dp, st::DP, 0.02),
         Check::report(case, "recirculation length L_a (m)", m.la, st::LA),
-        // LBM codes converge slowly in c_L (REFERENCES.md): reported only.
+        // LBM codes converge slowly in c_L (docs/validation.md): reported only.
         Check::report(case, "lift coefficient c_L", m.cl, st::CL),
         // The issue's gates hold "at D ≥ 40 cells".
         Check::at_least(case, "cylinder diameter in cells", cells, 40.0),
@@ -409,7 +409,7 @@ pub fn run_array(fidelity: Fidelity) -> Result<Report> {
     for (phi, reference) in SANGANI_ACRIVOS {
         let m = array_drag(&base, phi, true)?;
         interpolated.push((phi, m.drag));
-        // Gate of the issue: 3 % (REFERENCES.md: a stair-stepped cylinder lands within 2–4 %;
+        // Gate of the issue: 3 % (docs/validation.md: a stair-stepped cylinder lands within 2–4 %;
         // the interpolated wall sits on the true circle and should do better).
         checks.push(Check::rel(
             case,

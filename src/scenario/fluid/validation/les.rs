@@ -217,5 +217,5 @@ fn profile_plot(o: &Outcome, laminar: &MixingChannel, n: usize) -> Plot {
 }
 
 /// Tolerance on max |u − u_LES|/u_max at H = 32: twice the BGK bounce-back slip estimate
-/// (3 − 16Λ)/(3H²) ≈ 7e-4 at H = 32 (module docs; REFERENCES.md "Plane Poiseuille"), rounded up.
+/// (3 − 16Λ)/(3H²) ≈ 7e-4 at H = 32 (module docs; docs/validation.md "Poiseuille"), rounded up.
 const LES_TOL: f64 = 2e-3;

@@ -1,7 +1,7 @@
 //! Plane Poiseuille flow driven by a body force (validation case `poiseuille`).
 //!
 //! Periodic in x, half-way bounce-back walls at y = 0 and y = H. The steady solution is
-//! u(y) = g/(2ν)·y(H − y) (REFERENCES.md, "Plane Poiseuille"). Checked:
+//! u(y) = g/(2ν)·y(H − y) (docs/validation.md, "Poiseuille"). Checked:
 //!
 //! * BGK at the "magic" τ = ½ + √3/4 reproduces the parabola to round-off (Λ = 3/16 puts the
 //!   wall exactly half-way), and so does MRT at τ = 0.8 with the magic s_q when the energy
@@ -138,7 +138,7 @@ pub fn run(f: Fidelity) -> Result<Report> {
     };
     let mut checks = Vec::new();
 
-    // Magic τ: exact to round-off (REFERENCES.md: "at that τ the parabola is reproduced to
+    // Magic τ: exact to round-off (docs/validation.md: "at that τ the parabola is reproduced to
     // round-off"; the issue's gate is 1e-10 relative in f64).
     for &n in cells {
         let p = solve(&base, n, magic_tau, Collision::Bgk)?;
@@ -190,7 +190,7 @@ pub fn run(f: Fidelity) -> Result<Report> {
     ));
 
     // MRT at τ = 0.8 with the magic s_q and s_e = s_ε = s_ν (a TRT): exact to round-off
-    // (REFERENCES.md, TRT magic Λ = 3/16; the same 1e-10 as the BGK gate).
+    // (docs/validation.md, TRT magic Λ = 3/16; the same 1e-10 as the BGK gate).
     let n = cells[1];
     let s_nu = 1.0 / TAU_OFF_MAGIC;
     let trt = MrtSpec {

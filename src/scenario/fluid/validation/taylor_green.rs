@@ -2,7 +2,7 @@
 //!
 //! With k = 2π/L the incompressible Navier–Stokes equations have the exact solution
 //! u = −U₀cos(kx)sin(ky)e^(−2νk²t), v = U₀sin(kx)cos(ky)e^(−2νk²t),
-//! p = −ρU₀²/4·(cos 2kx + cos 2ky)e^(−4νk²t) (REFERENCES.md, "Taylor–Green vortex"), so the
+//! p = −ρU₀²/4·(cos 2kx + cos 2ky)e^(−4νk²t) (docs/validation.md, "Taylor–Green vortex"), so the
 //! kinetic energy decays as e^(−4νk²t).
 //!
 //! Initialisation: the analytic velocity and pressure (ρ = 1 + 3p* in lattice units) with the

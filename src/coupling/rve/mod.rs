@@ -18,8 +18,10 @@
 //!
 //! A point's state is its cell (grains, velocities, contact springs, cell matrix): moved, not
 //! copied, when the points are re-sorted, and copied whole by the MPM's snapshot, so a redone
-//! step restores it. A cell that fails (grains through each other, a cell thinner than two
-//! cut-offs, a state no longer finite) fails the point's update with the reason.
+//! step restores it. A volume stretched thinner than two contact cut-offs is re-tiled (twice
+//! the grains, the same packing; [`PeriodicCell`]); a cell that fails (grains through each
+//! other, stretched past its re-tiling limit, a state no longer finite) fails the point's
+//! update with the reason.
 //!
 //! **Initial state.** Every point starts from a copy of one prepared packing (a
 //! [`crate::dem::periodic_cell::Preparation`] at the target packing fraction and isotropic

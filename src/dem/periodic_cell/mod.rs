@@ -8,7 +8,13 @@
 //! **d** = H(**s** − round(**s**)) with **s** = H⁻¹(**x**_j − **x**_i), exact while the basis is
 //! reduced (|**a**·**b**| ≤ ½ min(|**a**|², |**b**|²): Lagrange–Gauss reduction is applied
 //! whenever the deformation skews the cell further; it changes the basis, not the lattice of
-//! images) and the cell is wider than two cut-offs across each pair of sides (refused below).
+//! images) and the cell is wider than two cut-offs across each pair of sides.
+//!
+//! **Re-tiling.** A cell stretched along one axis grows thin across the other; when it is no
+//! wider than two cut-offs there, it is re-tiled: the same periodic packing is described by a
+//! cell twice as thick holding each grain and a copy of it one period over (contact springs
+//! mapped to the image pairs they belong to), so the stress is continuous and the volume costs
+//! twice as much from then on. A cell is refused past [`MAX_TILES`] copies.
 //!
 //! **Motion.** With an imposed velocity gradient L (1/s), the grains move with the affine
 //! field L**x** plus their fluctuation **u**: per step of size h,
@@ -97,7 +103,13 @@ pub struct PeriodicCell {
     /// The deepest overlap relative to the smaller radius at the last evaluation.
     deepest: f64,
     steps: u64,
+    /// Copies of the original packing the cell holds (1, 2, 4, …; see `retile`).
+    tiles: u32,
 }
+
+/// Most copies of its packing a cell may grow to by [`PeriodicCell::retile`] (a volume
+/// stretched about 30-fold along one axis; each copy costs as much as the original).
+pub const MAX_TILES: u32 = 8;
 
 /// Largest overlap relative to the smaller radius before the cell refuses to go on (grains
 /// passing through each other).
@@ -144,6 +156,7 @@ impl PeriodicCell {
             skin,
             thickness,
             cutoff,
+            tiles: 1,
             ..Default::default()
         };
         c.wrap();
@@ -180,6 +193,11 @@ impl PeriodicCell {
     /// Steps taken.
     pub fn steps(&self) -> u64 {
         self.steps
+    }
+
+    /// Copies of the original packing the cell holds: 1, doubled by each re-tiling.
+    pub fn tiles(&self) -> u32 {
+        self.tiles
     }
 
     /// Stop every grain (fluctuation velocities and spins to zero) and re-evaluate the forces:
@@ -297,8 +315,9 @@ impl PeriodicCell {
     }
 
     /// Take `n` steps of size `h` (≤ the cell's step) under the velocity gradient `grad`.
-    /// Refuses (with the reason) a cell that grew too thin for its cut-off, grains passing
-    /// through each other, or a state that is no longer finite.
+    /// A cell that grows thinner than two cut-offs is re-tiled (see the module doc). Refuses
+    /// (with the reason) a cell that would need more than [`MAX_TILES`] copies of its packing,
+    /// grains passing through each other, or a state that is no longer finite.
     pub fn deform(&mut self, grad: &Tensor, n: u64, h: f64) -> Result<(), String> {
         self.grad = *grad;
         for _ in 0..n {
@@ -306,12 +325,21 @@ impl PeriodicCell {
             let (a, b) = (self.cell.column(0), self.cell.column(1));
             let det = self.area();
             let width = (det / a.norm()).min(det / b.norm());
-            if width.is_nan() || width <= 2.0 * self.cutoff {
-                return Err(format!(
-                    "the periodic cell is {width:.3e} m across, less than two cut-offs \
-                     (2 × {:.3e} m): too few grains for this deformation",
-                    self.cutoff
-                ));
+            if width.is_nan() {
+                return Err("the periodic cell's shape is no longer finite".into());
+            }
+            if width <= 2.0 * self.cutoff {
+                if self.tiles >= MAX_TILES {
+                    return Err(format!(
+                        "the periodic cell is {width:.3e} m across, less than two cut-offs \
+                         (2 × {:.3e} m), and already {} copies of its packing ({} grains): \
+                         the deformation is too large for this volume",
+                        self.cutoff,
+                        self.tiles,
+                        self.len()
+                    ));
+                }
+                self.retile();
             }
             if self.deepest > CELL_OVERLAP_LIMIT {
                 return Err(format!(
@@ -391,6 +419,77 @@ impl PeriodicCell {
             changed = true;
         }
         changed
+    }
+
+    /// Describe the same periodic packing by a cell twice as thick across its thinner pair of
+    /// sides: with **t** the side vector that the thin direction crosses (the shorter of **a**,
+    /// **b**; the width across the other pair of sides is A/|**t**|, the smaller), the new cell
+    /// has **t** ← 2**t** and holds every grain i and its copy i + N at **x**_i + **t** with
+    /// the same velocities, spins and forces. A pair (i, j) whose minimum image is the image
+    /// **n** of j becomes the pairs (i, j) and (i + N, j + N) when n_t is even, and (i, j + N)
+    /// and (j, i + N) when it is odd; the contact state goes with it, the rolling spring and
+    /// moment negated where j becomes the pair's first grain (the normal and the tangent turn
+    /// over with the pair, so normal and tangential springs keep their signs). The grains'
+    /// images, and so every force and the stress, are unchanged; the extensive energies
+    /// double with the cell.
+    fn retile(&mut self) {
+        let n = self.len();
+        let inv = self.cell.try_inverse().expect("a cell of positive area");
+        let k = if self.cell.column(0).norm() <= self.cell.column(1).norm() {
+            0
+        } else {
+            1
+        };
+        let t = self.cell.column(k).into_owned();
+        self.x.extend_from_within(..);
+        self.y.extend_from_within(..);
+        for i in n..2 * n {
+            self.x[i] += t.x;
+            self.y[i] += t.y;
+        }
+        for v in [
+            &mut self.ux,
+            &mut self.uy,
+            &mut self.w,
+            &mut self.r,
+            &mut self.m,
+            &mut self.j,
+        ] {
+            v.extend_from_within(..);
+        }
+        self.f.extend_from_within(..);
+        self.disp.extend_from_within(..);
+        let mut pairs = Vec::with_capacity(2 * self.pairs.len());
+        for (&(i, j), st) in self.pairs.iter().zip(&self.state) {
+            let (iu, ju) = (i as usize, j as usize);
+            let s = inv * Vector2::new(self.x[ju] - self.x[iu], self.y[ju] - self.y[iu]);
+            let n = n as u32;
+            if s[k].round().rem_euclid(2.0) == 0.0 {
+                pairs.push(((i, j), *st));
+                pairs.push(((i + n, j + n), *st));
+            } else {
+                let turned = ContactState {
+                    theta: -st.theta,
+                    m_r: -st.m_r,
+                    ..*st
+                };
+                pairs.push(((i, j + n), *st));
+                pairs.push(((j, i + n), turned));
+            }
+        }
+        pairs.sort_unstable_by_key(|p| p.0);
+        (self.pairs, self.state) = pairs.into_iter().unzip();
+        self.cell.set_column(k, &(2.0 * t));
+        self.virial *= 2.0;
+        self.fabric *= 2.0;
+        self.contacts *= 2;
+        self.stored *= 2.0;
+        self.dissipated *= 2.0;
+        self.work *= 2.0;
+        self.tiles *= 2;
+        self.reduce();
+        self.wrap();
+        self.build();
     }
 
     /// Minimum image **d** = **x**_j − **x**_i of a separation.

@@ -245,3 +245,114 @@ fn the_servo_refuses_what_it_cannot_hold() {
     }
     assert_eq!(cell.steps(), 0);
 }
+
+/// The glass beads with rolling resistance (k_r ≈ k_n r²/2.5, a damper well below critical,
+/// μ_r = 0.1), so that re-tiling is checked on loaded rolling springs too.
+fn with_rolling(c: &mut PeriodicCell) {
+    c.set_law(&ContactParams {
+        rolling_stiffness: 1.0,
+        rolling_damping: 1e-6,
+        rolling_friction: 0.1,
+        ..preparation(1, 0.8).contact
+    });
+}
+
+/// Re-tiling describes the same packing: re-evaluated from the mapped contact springs, every
+/// grain and its copy feel the force and torque the grain felt before (to round-off), the
+/// stress, fabric, coordination and packing fraction are unchanged, and the energies double.
+/// A wrong sign of a turned-over rolling spring shows in the torques.
+#[test]
+fn a_retiled_cell_is_the_same_packing() {
+    let mut c = prepared();
+    with_rolling(&mut c);
+    let dt = c.dt();
+    // Shear with compression: skewed cell, sliding contacts, loaded rolling springs.
+    c.deform(
+        &Tensor::new(0.0, 1.0, 0.0, -0.5),
+        (0.01 / dt).ceil() as u64,
+        dt,
+    )
+    .unwrap();
+    c.forces(0.0, false);
+    assert!(c.state.iter().any(|s| s.touching() && s.m_r.abs() > 0.0));
+    let (n, s0, fab0, z0, phi0, e0) = (
+        c.len(),
+        c.stress(),
+        c.fabric(),
+        c.coordination(),
+        c.packing_fraction(),
+        c.energy(),
+    );
+    let f0 = c.f.clone();
+    c.retile();
+    assert_eq!((c.len(), c.tiles()), (2 * n, 2));
+    c.forces(0.0, false);
+    assert!(
+        norm(&(c.stress() - s0)) < 1e-10 * norm(&s0),
+        "{} vs {s0}",
+        c.stress()
+    );
+    assert!(norm(&(c.fabric() - fab0)) < 1e-12);
+    assert_eq!(c.coordination(), z0);
+    assert!((c.packing_fraction() - phi0).abs() < 1e-12);
+    // The copies' positions carry a round-off ε|x| ≈ 1e-18 m beside overlaps f/k_n ≈ 1e-9 m:
+    // forces agree to ≈ 1e-9 of the largest; a turned-over rolling moment that kept its sign
+    // would be off by 2 m_r ≈ 1e-3 of the largest torque.
+    for k in 0..3 {
+        let scale = f0.iter().fold(0.0f64, |a, f| a.max(f[k].abs()));
+        for i in 0..n {
+            for copy in [i, i + n] {
+                assert!(
+                    (c.f[copy][k] - f0[i][k]).abs() < 1e-7 * scale,
+                    "grain {i} (as {copy}), component {k}: {} vs {}",
+                    c.f[copy][k],
+                    f0[i][k]
+                );
+            }
+        }
+    }
+    let e = c.energy();
+    assert!((e.stored - 2.0 * e0.stored).abs() < 1e-10 * e0.stored);
+    assert!((e.kinetic - 2.0 * e0.kinetic).abs() < 1e-10 * e0.kinetic.max(1e-300));
+    assert_eq!(e.work, 2.0 * e0.work);
+}
+
+/// Stretched along x and squeezed along y at constant area until it is thinner than two
+/// cut-offs across y, the cell re-tiles instead of stopping: twice the grains, the packing
+/// fraction kept (the path is isochoric), and the energy still balances over the whole path
+/// (work in = ΔK + ΔU + dissipated within 1 %, as for [`work_in_equals_stored_plus_dissipated`]:
+/// re-tiling doubles every term at once).
+#[test]
+fn a_cell_stretched_thin_is_retiled_and_keeps_the_balance() {
+    let mut c = prepared();
+    with_rolling(&mut c);
+    let (n, phi0) = (c.len(), c.packing_fraction());
+    let dt = c.dt();
+    let rate = 20.0;
+    let mut strain = 0.0;
+    while c.tiles() == 1 {
+        assert!(strain < 2.0, "no re-tiling by a strain of {strain}");
+        let e0 = c.energy();
+        let k = (0.05 / (rate * dt)).ceil() as u64;
+        c.deform(&Tensor::new(rate, 0.0, 0.0, -rate), k, dt)
+            .unwrap();
+        strain += k as f64 * rate * dt;
+        if c.tiles() == 2 {
+            let e = c.energy();
+            let work = e.work - 2.0 * e0.work;
+            let balance = (e.stored - 2.0 * e0.stored)
+                + (e.kinetic - 2.0 * e0.kinetic)
+                + (e.dissipated - 2.0 * e0.dissipated);
+            assert!(
+                (work - balance).abs() < 0.01 * work.abs(),
+                "over the re-tiling: W = {work}, ΔE + D = {balance}"
+            );
+        }
+    }
+    assert_eq!(c.len(), 2 * n);
+    // det(I + hL) = 1 − (h ε̇)² per step: the area drifts by h ε̇ × strain ≈ 1e-4.
+    assert!((c.packing_fraction() - phi0).abs() < 1e-3 * phi0);
+    let (a, b) = (c.cell().column(0), c.cell().column(1));
+    let width = (c.area() / a.norm()).min(c.area() / b.norm());
+    assert!(width > 2.0 * c.cutoff, "{width} m across after re-tiling");
+}

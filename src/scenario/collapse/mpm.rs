@@ -5,7 +5,7 @@
 //!   stress components, mean stress p = tr σ/3, deviatoric (von Mises) stress q = √(3J₂),
 //!   equivalent plastic strain, volume) and `grid_NNNNNN.vti` (part 1: per cell the mass
 //!   density and mean velocity of the points in it); with a representative-volume material
-//!   the points also carry each volume's packing fraction, coordination and fabric, and
+//!   the points also carry each volume's packing fraction, coordination, fabric and grains, and
 //!   `volume_<k>_NNNNNN.vtu` (part 2 + k) the grains of the volumes chosen with
 //!   [`run_column_collapse_with`];
 //! * `timeseries.csv`: t, t/τ_c, run-out, front, height, energies, budget error (the DEM's
@@ -67,8 +67,8 @@ impl PointOutput for MaterialModel {
     }
 }
 
-/// A representative volume's packing fraction, coordination number and fabric tensor
-/// (1/N_c) Σ n ⊗ n (xx, yy, xy) at each point.
+/// A representative volume's packing fraction, coordination number, fabric tensor
+/// (1/N_c) Σ n ⊗ n (xx, yy, xy) and number of grains (grown by re-tiling) at each point.
 impl PointOutput for RveMaterial {
     fn point_scalars(states: &[PeriodicCell]) -> Vec<(&'static str, Vec<f64>)> {
         let of = |f: &dyn Fn(&PeriodicCell) -> f64| states.iter().map(f).collect::<Vec<f64>>();
@@ -78,6 +78,7 @@ impl PointOutput for RveMaterial {
             ("fabric_xx", of(&|c| c.fabric()[(0, 0)])),
             ("fabric_yy", of(&|c| c.fabric()[(1, 1)])),
             ("fabric_xy", of(&|c| c.fabric()[(0, 1)])),
+            ("grains", of(&|c| c.len() as f64)),
         ]
     }
     const SOLVER: &'static str = "mpm-rve";

@@ -168,8 +168,9 @@ fn check_mpm(path: &Path) -> Result<ExitCode> {
             p.dt
         );
         println!(
-            "run time        at most {:.0} s on {threads} threads to end_tc ({:.2e} grain-steps \
-             at {RVE_NS_PER_GRAIN_STEP} ns each, measured; a run at rest stops earlier), after \
+            "run time        about {:.0} s on {threads} threads to end_tc ({:.2e} grain-steps \
+             at {RVE_NS_PER_GRAIN_STEP} ns each, measured; a run at rest stops earlier, a \
+             volume re-tiled when stretched thin costs twice as much from then on), after \
              preparing the volume and driving the points' copies to their stresses (not \
              bounded: seconds to minutes)",
             grain_steps * RVE_NS_PER_GRAIN_STEP * 1e-9 / threads,

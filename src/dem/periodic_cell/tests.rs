@@ -300,13 +300,13 @@ fn a_retiled_cell_is_the_same_packing() {
     // would be off by 2 m_r ≈ 1e-3 of the largest torque.
     for k in 0..3 {
         let scale = f0.iter().fold(0.0f64, |a, f| a.max(f[k].abs()));
-        for i in 0..n {
+        for (i, fi) in f0.iter().enumerate() {
             for copy in [i, i + n] {
                 assert!(
-                    (c.f[copy][k] - f0[i][k]).abs() < 1e-7 * scale,
+                    (c.f[copy][k] - fi[k]).abs() < 1e-7 * scale,
                     "grain {i} (as {copy}), component {k}: {} vs {}",
                     c.f[copy][k],
-                    f0[i][k]
+                    fi[k]
                 );
             }
         }

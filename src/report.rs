@@ -117,6 +117,8 @@ pub struct Series {
     pub style: Style,
     /// Palette index of the colour; `None`: the series' position in the plot.
     pub colour: Option<usize>,
+    /// Marker shape index (markers only); `None`: the series' position among the markers.
+    pub shape: Option<usize>,
 }
 
 impl Series {
@@ -127,6 +129,7 @@ impl Series {
             points,
             style: Style::Line,
             colour: None,
+            shape: None,
         }
     }
 
@@ -137,6 +140,7 @@ impl Series {
             points,
             style: Style::Markers,
             colour: None,
+            shape: None,
         }
     }
 
@@ -151,6 +155,12 @@ impl Series {
     /// Draw in palette colour `k` (so related series can share a colour).
     pub fn coloured(mut self, k: usize) -> Self {
         self.colour = Some(k);
+        self
+    }
+
+    /// Draw markers of shape `k` (so the series of one group share a shape).
+    pub fn shaped(mut self, k: usize) -> Self {
+        self.shape = Some(k);
         self
     }
 

@@ -418,8 +418,8 @@ fn draw(
                 }
             }
             Style::Markers => {
-                // Shapes differ between marker series so that coinciding points stay visible.
-                // 0: filled circle, 1: open square, 2: cross, 3: open triangle.
+                // Shapes differ between marker series (or groups of them, `Series::shape`) so
+                // that coinciding points stay visible. 0: filled circle, 1: open square, 2: cross, 3: open triangle.
                 let (fill, thin, thick) = (
                     colour.filled(),
                     colour.stroke_width(1),
@@ -438,7 +438,7 @@ fn draw(
                         }
                     }};
                 }
-                match markers % 4 {
+                match s.shape.unwrap_or(markers) % 4 {
                     0 => shape!(p => Circle::new(p, 3, fill)),
                     1 => {
                         shape!(p => EmptyElement::at(p) + Rectangle::new([(-4, -4), (4, 4)], thin))

@@ -5,7 +5,8 @@
 //! 2. `height`: H_f/L_i against a (log–log), with H_f/L_i = a (a ≲ 0.7) and the weaker
 //!    a^(1/3) quoted for experiments (drawn from a = 0.7 on, continuous there);
 //! 3. `front`: (L − L_i)/L_i against t/τ_c for every case, DEM lines, MPM markers and MPM×DEM
-//!    dashed lines in one colour per aspect ratio (the DEM lines name the aspect ratio);
+//!    dashed lines in one colour per aspect ratio (the DEM lines name the aspect ratio), MPM
+//!    cases that differ in more than a in one marker shape per such group (named once);
 //! 4. `energy_<case>`: the energy budget against t/τ_c (potential released, kinetic,
 //!    dissipated by collisions, friction, rolling resistance and plastic flow), as fractions of
 //!    the potential energy released by the end, for each solver's shortest and tallest column.
@@ -157,6 +158,24 @@ fn fronts(dir: &Path, cases: &[CaseResult]) -> Result<()> {
         .filter(|(c, _)| c.case.solver == Solver::Dem)
         .map(|(c, o)| nominal_a(c, o))
         .collect();
+    // MPM cases that differ in more than a (e.g. points per cell) get one marker shape per
+    // such group, named once in the legend; so is the MPM×DEM line style.
+    let group = |c: &CaseResult| -> String {
+        c.case
+            .labels
+            .iter()
+            .filter(|(p, _)| p != "column.aspect_ratio")
+            .map(|(p, v)| format!("{} = {v}", p.rsplit('.').next().unwrap_or(p)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut groups: Vec<String> = Vec::new();
+    for c in cases.iter().filter(|c| c.case.solver == Solver::Mpm) {
+        if !groups.contains(&group(c)) {
+            groups.push(group(c));
+        }
+    }
+    let (mut named, mut named_rve) = (vec![false; groups.len()], false);
     let mut plot = Plot::new(
         "front",
         "Run-out against time: DEM lines, MPM markers, MPM×DEM dashed, one colour per a",
@@ -179,10 +198,25 @@ fn fronts(dir: &Path, cases: &[CaseResult]) -> Result<()> {
         plot.series.push(
             match c.case.solver {
                 Solver::Dem => Series::line(&name, pts).decimated(400),
-                // Unlabelled where the DEM line of the same colour names the aspect ratio.
-                Solver::Mpm if dem_a.contains(&a) => Series::markers("", pts).decimated(40),
-                Solver::Mpm => Series::markers(&format!("MPM {name}"), pts).decimated(40),
-                Solver::Rve if dem_a.contains(&a) => Series::dashed("", pts).decimated(400),
+                Solver::Mpm => {
+                    let g = groups.iter().position(|g| *g == group(c)).unwrap_or(0);
+                    // The DEM line of the same colour names the aspect ratio; a group is
+                    // named by its first series.
+                    let label = match (dem_a.contains(&a), groups[g].is_empty()) {
+                        (true, true) => String::new(),
+                        (true, false) if named[g] => String::new(),
+                        (true, false) => format!("MPM {}", groups[g]),
+                        (false, true) => format!("MPM {name}"),
+                        (false, false) => format!("MPM {name}, {}", groups[g]),
+                    };
+                    named[g] = true;
+                    Series::markers(&label, pts).decimated(40).shaped(g)
+                }
+                Solver::Rve if dem_a.contains(&a) => {
+                    let label = if named_rve { "" } else { "MPM×DEM" };
+                    named_rve = true;
+                    Series::dashed(label, pts).decimated(400)
+                }
                 Solver::Rve => Series::dashed(&format!("MPM×DEM {name}"), pts).decimated(400),
             }
             .coloured(colour),

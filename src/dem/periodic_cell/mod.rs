@@ -107,8 +107,8 @@ pub struct PeriodicCell {
     tiles: u32,
 }
 
-/// Most copies of its packing a cell may grow to by [`PeriodicCell::retile`] (a volume
-/// stretched about 30-fold along one axis; each copy costs as much as the original).
+/// Most copies of its packing a cell may grow to by re-tiling (three re-tilings, each
+/// doubling the cell's cost).
 pub const MAX_TILES: u32 = 8;
 
 /// Largest overlap relative to the smaller radius before the cell refuses to go on (grains

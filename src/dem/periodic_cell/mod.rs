@@ -40,13 +40,15 @@
 //! hundred grains of a representative volume) when twice the largest fluctuation displacement
 //! plus the affine change of the cut-off, r_c Σ h‖L‖, exceeds the skin.
 
+mod pairs;
 mod prepare;
 
+pub(crate) use pairs::{carry_history, disk_motion, scatter};
 pub use prepare::{Preparation, Prepared, Servo, Target};
 
 use nalgebra::{Matrix2, Vector2};
 
-use super::contact::{ContactParams, ContactState, Law, Motion};
+use super::contact::{ContactParams, ContactState, Law};
 
 /// A 2×2 tensor (cell matrix, velocity gradient, stress, fabric).
 pub type Tensor = Matrix2<f64>;
@@ -520,21 +522,8 @@ impl PeriodicCell {
                 }
             }
         }
-        let mut state = Vec::with_capacity(pairs.len());
-        let mut k = 0;
-        for p in &pairs {
-            while k < self.pairs.len() && self.pairs[k] < *p {
-                k += 1;
-            }
-            let kept = k < self.pairs.len() && self.pairs[k] == *p;
-            state.push(if kept {
-                self.state[k]
-            } else {
-                ContactState::default()
-            });
-        }
+        self.state = carry_history(&self.pairs, &self.state, &pairs);
         self.pairs = pairs;
-        self.state = state;
         self.disp.iter_mut().for_each(|d| *d = [0.0; 2]);
         self.strain_since_build = 0.0;
     }
@@ -613,7 +602,6 @@ impl PeriodicCell {
             } else {
                 (1.0, 0.0)
             };
-            let (tx, ty) = (-ny, nx);
             let (mi, mj) = (m[i], m[j]);
             // Mid-step and predictor velocities of i relative to j's image: u_i − u_j − L d.
             let (dvx, dvy) = (
@@ -629,31 +617,19 @@ impl PeriodicCell {
                 wi + half * f[i][2] / inertia[i],
                 wj + half * f[j][2] / inertia[j],
             );
-            let motion = Motion {
-                delta: rs - d,
-                u: [dvx * nx + dvy * ny, ex * nx + ey * ny],
-                v_t: [
-                    dvx * tx + dvy * ty + wi * ri + wj * rj,
-                    ex * tx + ey * ty + pwi * ri + pwj * rj,
-                ],
-                w: [wi - wj, pwi - pwj],
-                m_eff: mi * mj / (mi + mj),
-                r_eff: ri * rj / rs,
-            };
+            let (n, r) = ([nx, ny], [ri, rj]);
+            let motion = disk_motion(
+                d,
+                n,
+                [[dvx, dvy], [ex, ey]],
+                [[wi, pwi], [wj, pwj]],
+                [mi, mj],
+                r,
+            );
             let out = self.law.resolve(&motion, st, h);
             dissipated += out.d_normal + out.d_friction + out.d_rolling;
-            let push = |f: &mut Vec<[f64; 3]>, [an, at, ar]: [f64; 3]| {
-                let (f0, f1) = (-an * nx + at * tx, -an * ny + at * ty);
-                f[i][0] += f0;
-                f[i][1] += f1;
-                f[i][2] += ri * at + ar;
-                f[j][0] -= f0;
-                f[j][1] -= f1;
-                f[j][2] += rj * at - ar;
-                (f0, f1)
-            };
-            push(fe, out.apply);
-            let (f0, f1) = push(ft, [st.f_n, st.f_t, st.m_r]);
+            scatter(fe, (i, j), n, r, out.apply);
+            let (f0, f1) = scatter(ft, (i, j), n, r, [st.f_n, st.f_t, st.m_r]);
             if st.touching() {
                 contacts += 1;
                 stored += out.e_normal + out.e_tangential + out.e_rolling;

@@ -39,7 +39,7 @@
 //! flow's own relative shift γ̇ r_c t over the cut-off r_c, exceeds the skin.
 
 use super::contact::{ContactParams, ContactState, Law};
-use super::periodic_cell::{carry_history, disk_motion, scatter, Tensor};
+use super::periodic_cell::{carry_history, disk_motion, pairs_within, scatter, Tensor};
 
 /// The periodic cell and its grains (structure of arrays).
 pub struct Cell {
@@ -166,23 +166,11 @@ impl Cell {
     /// Rebuild the pair list (pairs within R_i + R_j + skin), carrying the contact history
     /// of the pairs kept over by a merge of the two sorted lists.
     fn build(&mut self) {
-        let n = self.len();
-        let mut pairs = Vec::with_capacity(self.pairs.len().max(4 * n));
-        for i in 0..n {
-            for j in i + 1..n {
-                let (dx, dy, _) = min_image(
-                    self.x[j] - self.x[i],
-                    self.y[j] - self.y[i],
-                    self.lx,
-                    self.ly,
-                    self.offset,
-                );
-                let reach = self.r[i] + self.r[j] + self.skin;
-                if dx * dx + dy * dy < reach * reach {
-                    pairs.push((i as u32, j as u32));
-                }
-            }
-        }
+        let (lx, ly, offset) = (self.lx, self.ly, self.offset);
+        let pairs = pairs_within(&self.x, &self.y, &self.r, self.skin, |dx, dy| {
+            let (dx, dy, _) = min_image(dx, dy, lx, ly, offset);
+            (dx, dy)
+        });
         self.state = carry_history(&self.pairs, &self.state, &pairs);
         self.pairs = pairs;
         self.disp.iter_mut().for_each(|d| *d = [0.0; 2]);

@@ -43,7 +43,7 @@
 mod pairs;
 mod prepare;
 
-pub(crate) use pairs::{carry_history, disk_motion, scatter};
+pub(crate) use pairs::{carry_history, disk_motion, pairs_within, scatter};
 pub use prepare::{Preparation, Prepared, Servo, Target};
 
 use nalgebra::{Matrix2, Vector2};
@@ -505,23 +505,10 @@ impl PeriodicCell {
     /// Rebuild the pair list (pairs within R_i + R_j + skin), carrying the contact history
     /// of the pairs kept over by a merge of the two sorted lists.
     fn build(&mut self) {
-        let n = self.len();
         let inv = self.cell.try_inverse().expect("a cell of positive area");
-        let mut pairs = Vec::with_capacity(self.pairs.len().max(4 * n));
-        for i in 0..n {
-            for j in i + 1..n {
-                let (dx, dy) = Self::min_image(
-                    &inv,
-                    &self.cell,
-                    self.x[j] - self.x[i],
-                    self.y[j] - self.y[i],
-                );
-                let reach = self.r[i] + self.r[j] + self.skin;
-                if dx * dx + dy * dy < reach * reach {
-                    pairs.push((i as u32, j as u32));
-                }
-            }
-        }
+        let pairs = pairs_within(&self.x, &self.y, &self.r, self.skin, |dx, dy| {
+            Self::min_image(&inv, &self.cell, dx, dy)
+        });
         self.state = carry_history(&self.pairs, &self.state, &pairs);
         self.pairs = pairs;
         self.disp.iter_mut().for_each(|d| *d = [0.0; 2]);

@@ -5,6 +5,30 @@
 
 use crate::dem::contact::{ContactState, Motion};
 
+/// The pairs (i < j, sorted) of disks at (x, y) with radii `r` whose separation, as
+/// `image` maps x_j − x_i, y_j − y_i to the nearest image's, is below R_i + R_j + `skin`: an
+/// O(N²) search, fine for the few hundred grains of a periodic cell.
+pub(crate) fn pairs_within(
+    x: &[f64],
+    y: &[f64],
+    r: &[f64],
+    skin: f64,
+    image: impl Fn(f64, f64) -> (f64, f64),
+) -> Vec<(u32, u32)> {
+    let n = x.len();
+    let mut pairs = Vec::with_capacity(4 * n);
+    for i in 0..n {
+        for j in i + 1..n {
+            let (dx, dy) = image(x[j] - x[i], y[j] - y[i]);
+            let reach = r[i] + r[j] + skin;
+            if dx * dx + dy * dy < reach * reach {
+                pairs.push((i as u32, j as u32));
+            }
+        }
+    }
+    pairs
+}
+
 /// The contact states of the sorted pair list `new`: carried from the sorted list `old` (with
 /// its `state`) for every pair on both lists, fresh for the others (a merge of the two lists).
 pub(crate) fn carry_history(

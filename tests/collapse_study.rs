@@ -1,6 +1,6 @@
 //! The column-collapse study in reduced form: `models/column_collapse/sweep_quick.toml` cut to
 //! a = 0.5 and 4, both solvers, run through `granflow::sweep::run_sweep`. Checked: the
-//! ordering and bands the study must show (issue 5; REFERENCES, granular column collapse),
+//! ordering and bands the study must show (issue 5; docs/references.md, column collapse run-out laws),
 //! not exact values; the outputs; and that a second run reuses every case.
 
 use granflow::sweep::{run_sweep, Solver};

@@ -23,7 +23,7 @@ fn assert_all(checks: &[Check]) {
     assert!(checks.iter().all(|c| c.pass));
 }
 
-/// e = 0.3…0.95 within 1 % (REFERENCES, DEM: linear spring-dashpot, contact ends at δ = 0).
+/// e = 0.3…0.95 within 1 % (docs/references.md, linear spring-dashpot: linear spring-dashpot, contact ends at δ = 0).
 #[test]
 fn restitution_within_one_percent() {
     assert_all(&validation::restitution(Fidelity::Test).unwrap());

@@ -22,7 +22,7 @@ pub fn spreading_end(history: &[(f64, f64)], tol: f64) -> f64 {
 
 /// What every collapse run reports, whatever the solver: the common part of `summary.json`
 /// (each runner adds its own keys beside these, through `#[serde(flatten)]`). Definitions:
-/// REFERENCES, granular column collapse; τ_c = √(H_i/g).
+/// docs/references.md, column collapse run-out laws; τ_c = √(H_i/g).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CollapseOutcome {
     /// Scenario name.

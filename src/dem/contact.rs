@@ -7,7 +7,7 @@
 //!
 //! * normal (seed eq. 5.58 plus a dashpot): f_n = k_n δ + c_n v_n, with
 //!   c_n = 2ξ√(m_eff k_n) + m_eff γ_n, m_eff = m_i m_j/(m_i + m_j) (m_i for a wall), and
-//!   ξ = −ln e/√(π² + ln² e) for a restitution coefficient e (REFERENCES, DEM). The force is
+//!   ξ = −ln e/√(π² + ln² e) for a restitution coefficient e (docs/references.md, linear spring-dashpot). The force is
 //!   **not** clipped at zero: the contact lasts until δ returns to 0, so the dashpot may pull
 //!   briefly at the end of an impact. With that definition the rebound ratio of a head-on
 //!   impact is exactly e = exp(−πξ/√(1 − ξ²)) (the solution of the damped oscillator at the
@@ -137,7 +137,7 @@ impl ContactParams {
         Ok(())
     }
 
-    /// Normal damping ratio ξ = −ln e/√(π² + ln² e) (REFERENCES, DEM).
+    /// Normal damping ratio ξ = −ln e/√(π² + ln² e) (docs/references.md, linear spring-dashpot).
     pub fn damping_ratio(&self) -> f64 {
         damping_ratio(self.restitution)
     }
@@ -546,7 +546,7 @@ mod tests {
     /// Isolated head-on impact, integrated exactly as the solver does (velocity Verlet with
     /// `resolve` for the force): the rebound ratio is e within 0.6 % at λ = 0.1 for every
     /// onset phase, and the error falls ≈ 4× per halving of the step (second order).
-    /// Reference: e = exp(−πξ/√(1 − ξ²)) of the linear spring-dashpot (REFERENCES, DEM).
+    /// Reference: e = exp(−πξ/√(1 − ξ²)) of the linear spring-dashpot (docs/references.md, linear spring-dashpot).
     #[test]
     fn single_impact_second_order() {
         fn rebound(e: f64, lambda: f64, phase: f64) -> f64 {

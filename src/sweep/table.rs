@@ -11,8 +11,8 @@ use crate::analysis::runout::CollapseOutcome;
 use crate::io::write_atomic;
 use crate::Result;
 
-/// A published run-out law ΔL = λ_s a (a < a_c), λ_l a^α (a > a_c) (REFERENCES, granular
-/// column collapse).
+/// A published run-out law ΔL = λ_s a (a < a_c), λ_l a^α (a > a_c) (docs/references.md,
+/// column collapse run-out laws).
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct ReferenceLaw {
     /// Source.

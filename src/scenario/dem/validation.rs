@@ -3,7 +3,7 @@
 //!
 //! | case | claim | reference |
 //! |---|---|---|
-//! | [`restitution`] | head-on grain–grain and grain–wall impacts rebound with the set e, within 1 % for e = 0.3…0.95 at λ = 0.1; the dashpot's booked dissipation equals the kinetic energy lost, within 1.5 % | linear spring-dashpot: e = exp(−πξ/√(1−ξ²)), the contact ending when δ returns to 0 (REFERENCES, DEM); energy conservation |
+//! | [`restitution`] | head-on grain–grain and grain–wall impacts rebound with the set e, within 1 % for e = 0.3…0.95 at λ = 0.1; the dashpot's booked dissipation equals the kinetic energy lost, within 1.5 % | linear spring-dashpot: e = exp(−πξ/√(1−ξ²)), the contact ending when δ returns to 0 (docs/references.md, linear spring-dashpot); energy conservation |
 //! | [`incline`] | frictionless disk on a 45° segment: a/g = sin 45° = 0.7071 within 0.5 %, ω = 0 | Newton's second law |
 //! | [`conservation`] | momentum conserved to round-off in grain–grain collisions; elastic gas in a box drifts < 0.1 % in energy over 10⁵ steps | Newton's third law; symplectic (velocity-Verlet) integration |
 //! | [`energy_budget`] | settling with friction, damping and rolling resistance: initial = current + dissipated within 1 % | energy conservation |

@@ -10,8 +10,8 @@
 //! * `timeseries.csv`: t, t/τ_c, run-out, front, height, energies, budget error;
 //! * `summary.json` ([`CollapseSummary`]).
 //!
-//! Definitions (docs/references.md, column collapse run-out laws): τ_c = √(H_i/g) with H_i the deposited
-//! height; the *main mass* is the largest set of grains connected through near-contacts, two
+//! Definitions (docs/references.md, column collapse run-out laws): τ_c = √(H_i/g) with H_i the
+//! deposited height; the *main mass* is the largest set of grains connected through near-contacts, two
 //! grains being connected when their gap is below [`CONNECT_GAP`] × (R_i + R_j) (at rest this
 //! is the thesis's "in contact with the main mass"; during the flow the small tolerance keeps
 //! the agitated mass from falling apart into clusters at every bounce, which made the

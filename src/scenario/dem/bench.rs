@@ -1,5 +1,5 @@
-//! `granflow bench dem`: the LAMMPS peer case `in.gran2d.lmp` (docs/performance.md), so granflow and LAMMPS's
-//! `gran/hooke/history` are timed on the same run.
+//! `granflow bench dem`: the LAMMPS peer case `in.gran2d.lmp` (docs/performance.md), so
+//! granflow and LAMMPS's `gran/hooke/history` are timed on the same run.
 //!
 //! Reduced (LJ) units: a hex-packed block of ≈ N disks (√N × √N, nearest-neighbour spacing 1),
 //! diameters uniform in [0.8, 1.0], density 1 with LAMMPS's mass convention for `set density`

@@ -189,17 +189,16 @@ pub fn validation(fidelity: crate::report::Fidelity) -> Result<Vec<crate::report
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/column_collapse/dem_a2.toml");
     let s = DemScenario::from_file(&path)?;
-    let (stresses, walls, volume, seeds): (&[f64], usize, usize, u64) = match fidelity {
-        Fidelity::Full => (&[300.0, 1000.0, 3000.0], 1000, 400, 3),
-        Fidelity::Test => (&[1000.0], 300, 150, 1),
-    };
-    // Full: to ε₁ = 0.45, so that the critical state (the mean over the second half of the
-    // strain) is read where both samples have stopped changing volume (to 0.3 the volume was
-    // still contracting, ε_v ≈ +0.02, docs/multiscale.md); the test tier stops at 0.3.
-    let strain = match fidelity {
-        Fidelity::Full => 0.45,
-        Fidelity::Test => 0.3,
-    };
+    // σ₃ (Pa), grains of the walled sample and of the volume, realisations, final strain and
+    // the tolerance on the σ₃ the volume holds. Full runs to ε₁ = 0.45, so that the critical
+    // state (the mean over the second half of the strain) is read where both samples have
+    // stopped changing volume (to 0.3 the volume was still contracting, ε_v ≈ +0.02,
+    // docs/multiscale.md).
+    let (stresses, walls, volume, seeds, strain, held): (&[f64], usize, usize, u64, f64, f64) =
+        match fidelity {
+            Fidelity::Full => (&[300.0, 1000.0, 3000.0], 1000, 400, 3, 0.45, 0.02),
+            Fidelity::Test => (&[1000.0], 300, 150, 1, 0.3, 0.05),
+        };
     // (σ₃, seed): [φ_c volume, φ_c walls, peak volume, peak walls], sin φ_c of both, σ₃ held.
     let pair = |sigma3: f64, seed: u64| -> Result<([f64; 4], [f64; 2], f64)> {
         let wall_spec =
@@ -234,10 +233,6 @@ pub fn validation(fidelity: crate::report::Fidelity) -> Result<Vec<crate::report
         .par_iter()
         .map(|&(s3, seed)| pair(s3, seed))
         .collect::<Result<Vec<_>>>()?;
-    let held = match fidelity {
-        Fidelity::Full => 0.02,
-        Fidelity::Test => 0.05,
-    };
     let mut out = Vec::new();
     let mut means = Vec::new();
     for (k, &sigma3) in stresses.iter().enumerate() {

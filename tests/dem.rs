@@ -524,3 +524,42 @@ fn conveyor_floor_drags_a_disk_to_a_third_of_its_speed() {
         w * r / (2.0 * v)
     );
 }
+
+/// Coordination and the load-carrying kinetic energy: a disk on the floor with another resting
+/// on it, and a third spinning in free fall. After the pair has settled (restitution 0.5) the
+/// contact counts are 2, 1, 0; the loaded kinetic energy is the total less the free disk's
+/// (to round-off), and falls to nothing while the free disk keeps its spin, which no contact
+/// can damp (ω unchanged bit for bit).
+#[test]
+fn a_free_spinning_grain_is_not_part_of_the_loaded_kinetic_energy() {
+    let (k, r, rho, g, w0) = (1e4, 0.01, 1.0, 9.81, 50.0);
+    let law = ContactParams {
+        restitution: 0.5,
+        ..ContactParams::elastic(k)
+    };
+    let mut grains = Grains::new();
+    grains.push_disk(0.0, r, r, rho);
+    grains.push_disk(0.0, 3.0 * r, r, rho);
+    grains.push_disk(0.1, 2.0, r, rho);
+    grains.omega[2] = w0;
+    let mut dem = Dem::new(
+        grains,
+        vec![Wall::floor(0.0)],
+        DemParams::new(law, law, [0.0, -g]),
+    )
+    .unwrap();
+    dem.advance_with(0.5, None).unwrap();
+    assert_eq!(dem.contacts_per_grain(), vec![2, 1, 0]);
+    let gr = &dem.grains;
+    let free = 0.5 * gr.mass[2] * (gr.vx[2].powi(2) + gr.vy[2].powi(2))
+        + 0.5 * gr.inertia[2] * gr.omega[2].powi(2);
+    let total = dem.energy().kinetic_total();
+    let loaded = dem.loaded_kinetic_energy();
+    assert!((loaded - (total - free)).abs() <= 1e-12 * total);
+    assert_eq!(gr.omega[2], w0);
+    let spin = 0.5 * gr.inertia[2] * w0 * w0;
+    assert!(
+        loaded < 1e-6 * spin,
+        "loaded K {loaded:e} J vs spin {spin:e} J"
+    );
+}

@@ -259,7 +259,10 @@ impl Sample {
 
     /// Bring the sample to rest at σ₃ on the right wall and the lid: run piston intervals
     /// until, over a block of them, both mean stresses are within 1 % of σ₃ and the kinetic
-    /// energy per grain is below 1e-7 σ₃ d̄² t.
+    /// energy of the load-carrying grains ([`Dem::loaded_kinetic_energy`]) is below
+    /// 1e-7 σ₃ d̄² t per grain. Rattlers are left out: a grain with no contact spinning freely
+    /// holds its energy for ever (seen: one such grain held 84 % of a 960-grain sample's
+    /// kinetic energy, 1.6× the threshold, while the wall stresses were at σ₃ to 0.01 %).
     fn consolidate(&mut self, sigma_3: f64, d_mean: f64, v_max: f64, max_time: f64) -> Result<()> {
         let rest = 1e-7 * sigma_3 * d_mean * d_mean * self.thickness * self.dem.grains.len() as f64;
         let block = 50;
@@ -272,7 +275,7 @@ impl Sample {
                 mean[1] += s[1] / block as f64;
             }
             let close = mean.iter().all(|s| (s / sigma_3 - 1.0).abs() < 0.01);
-            if close && self.dem.energy().kinetic_total() < rest {
+            if close && self.dem.loaded_kinetic_energy() < rest {
                 self.dem.set_wall_velocity(RIGHT, [0.0; 2])?;
                 self.dem.set_wall_velocity(LID, [0.0; 2])?;
                 self.piston[1] = Piston::default();

@@ -43,6 +43,15 @@ pub enum Error {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// The output folder cannot take the run (it holds an earlier run, is not a folder, is not
+    /// writable); refused before the run starts.
+    #[error("cannot write the run into {path} (--out): {reason}")]
+    Output {
+        /// The output folder.
+        path: PathBuf,
+        /// Why, and what to do instead.
+        reason: String,
+    },
     /// Anything else, with a message.
     #[error("{0}")]
     Other(String),

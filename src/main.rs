@@ -31,9 +31,14 @@ enum Command {
     Run {
         /// Scenario file (TOML).
         scenario: PathBuf,
-        /// Output folder (created if needed; files in it are replaced).
+        /// Output folder (created if needed; one that holds an earlier run is refused unless
+        /// --force).
         #[arg(long)]
         out: PathBuf,
+        /// Replace an earlier run in the output folder (everything in that folder is deleted;
+        /// only a folder granflow wrote is ever emptied).
+        #[arg(long)]
+        force: bool,
         /// With every frame, write the grains of the representative volume of the material
         /// point nearest X,Y (m) in the initial column as volume_<k>_<frame>.vtu (MPM files
         /// with model = "rve"; repeat for more volumes).
@@ -72,9 +77,14 @@ enum Command {
     Biaxial {
         /// DEM collapse scenario (TOML): its grains, contact laws and deposition are used.
         scenario: PathBuf,
-        /// Output folder (created if needed).
+        /// Output folder (created if needed; one that holds an earlier run is refused unless
+        /// --force).
         #[arg(long)]
         out: PathBuf,
+        /// Replace an earlier run in the output folder (everything in that folder is deleted;
+        /// only a folder granflow wrote is ever emptied).
+        #[arg(long)]
+        force: bool,
         /// Confining stress σ₃ (Pa), e.g. the mean stress in the column, ρ φ g H/2.
         #[arg(long, allow_negative_numbers = true)]
         confining: f64,
@@ -105,9 +115,14 @@ enum Command {
     Shear {
         /// DEM collapse scenario (TOML): its grains and grain–grain contact laws are used.
         scenario: PathBuf,
-        /// Output folder (created if needed).
+        /// Output folder (created if needed; one that holds an earlier run is refused unless
+        /// --force).
         #[arg(long)]
         out: PathBuf,
+        /// Replace an earlier run in the output folder (everything in that folder is deleted;
+        /// only a folder granflow wrote is ever emptied).
+        #[arg(long)]
+        force: bool,
         /// Normal stress σ_yy held by the cell's height (Pa).
         #[arg(long, allow_negative_numbers = true)]
         pressure: f64,
@@ -286,14 +301,19 @@ fn parse_place(s: &str) -> std::result::Result<[f64; 2], String> {
     }
 }
 
+fn out_of(dir: &std::path::Path, force: bool) -> cli::Out<'_> {
+    cli::Out { dir, force }
+}
+
 fn real_main() -> Result<ExitCode> {
     match Cli::parse().command {
         Command::Check { scenario } => cli::run::check(&scenario),
         Command::Run {
             scenario,
             out,
+            force,
             rve_frames,
-        } => cli::run::run(&scenario, &out, &rve_frames),
+        } => cli::run::run(&scenario, out_of(&out, force), &rve_frames),
         Command::Validate {
             case,
             json,
@@ -304,6 +324,7 @@ fn real_main() -> Result<ExitCode> {
         Command::Biaxial {
             scenario,
             out,
+            force,
             confining,
             grains,
             inertial_number,
@@ -313,7 +334,7 @@ fn real_main() -> Result<ExitCode> {
             periodic_packing_fraction,
         } => cli::study::biaxial(
             &scenario,
-            &out,
+            out_of(&out, force),
             [confining, inertial_number, strain],
             grains,
             prep_friction,
@@ -323,6 +344,7 @@ fn real_main() -> Result<ExitCode> {
         Command::Shear {
             scenario,
             out,
+            force,
             pressure,
             inertial_numbers,
             grains,
@@ -330,7 +352,7 @@ fn real_main() -> Result<ExitCode> {
             seed,
         } => cli::study::shear(
             &scenario,
-            &out,
+            out_of(&out, force),
             pressure,
             &inertial_numbers,
             grains,

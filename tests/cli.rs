@@ -445,3 +445,66 @@ fn rve_frames_need_a_representative_volume() {
         assert!(!out.exists(), "{file}: output written");
     }
 }
+
+/// A run never mixes its files with an earlier run's (issue 24): a second run into the same
+/// folder is refused naming `--force` and leaves the first run's files as they were; with
+/// `--force` the folder is emptied first (a stale frame planted in it is gone); a folder that
+/// granflow did not write is never emptied, `--force` or not.
+#[test]
+fn an_earlier_run_is_refused_unless_forced() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("run");
+    let run = |extra: &[&str]| {
+        granflow()
+            .arg("run")
+            .arg(data("tiny_channel.toml"))
+            .arg("--out")
+            .arg(&out_dir)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let first = run(&[]);
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+    let stale = out_dir.join("fluid_000099.vti");
+    std::fs::write(&stale, "from another run").unwrap();
+    let summary = std::fs::read(out_dir.join("summary.json")).unwrap();
+    let second = run(&[]);
+    assert!(!second.status.success());
+    let err = String::from_utf8_lossy(&second.stderr);
+    assert!(
+        err.contains("--force") && err.contains("earlier run"),
+        "{err}"
+    );
+    assert!(stale.exists());
+    assert_eq!(
+        std::fs::read(out_dir.join("summary.json")).unwrap(),
+        summary
+    );
+    let forced = run(&["--force"]);
+    assert!(
+        forced.status.success(),
+        "{}",
+        String::from_utf8_lossy(&forced.stderr)
+    );
+    assert!(!stale.exists() && out_dir.join("fluid_000004.vti").exists());
+    let mine = dir.path().join("mine");
+    std::fs::create_dir(&mine).unwrap();
+    std::fs::write(mine.join("notes.txt"), "keep").unwrap();
+    let refused = granflow()
+        .arg("run")
+        .arg(data("tiny_channel.toml"))
+        .arg("--out")
+        .arg(&mine)
+        .arg("--force")
+        .output()
+        .unwrap();
+    assert!(!refused.status.success());
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(err.contains("not a granflow run folder"), "{err}");
+    assert!(mine.join("notes.txt").exists());
+}

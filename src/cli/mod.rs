@@ -34,6 +34,25 @@ fn with_progress<R>(total: u64, unit: &str, f: impl FnOnce(&mut dyn FnMut(u64, u
     }
 }
 
+/// The output folder of a command that writes a run: `--out` and `--force`.
+#[derive(Clone, Copy)]
+pub struct Out<'a> {
+    /// The folder.
+    pub dir: &'a Path,
+    /// Replace an earlier run in it.
+    pub force: bool,
+}
+
+impl<'a> Out<'a> {
+    /// The folder, once it is known to take the run ([`granflow::io::run_dir::prepare`]:
+    /// an earlier run in it refused, or deleted with `--force`); call it after the input has
+    /// been checked, so that a refused input leaves an earlier run alone.
+    fn claim(self) -> granflow::Result<&'a Path> {
+        granflow::io::run_dir::prepare(self.dir, self.force)?;
+        Ok(self.dir)
+    }
+}
+
 /// Context for a run that failed part-way.
 fn stopped(path: &Path, out: &Path) -> String {
     format!(

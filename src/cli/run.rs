@@ -12,7 +12,7 @@ use granflow::scenario::mpm::MpmScenario;
 use granflow::scenario::submerged::SubmergedScenario;
 use granflow::scenario::{kind_of_file, Kind, ScenarioFile};
 
-use super::{stopped, with_progress};
+use super::{stopped, with_progress, Out};
 
 /// `granflow check`: parse, derive and print, refuse bad input; no run.
 pub fn check(path: &Path) -> Result<ExitCode> {
@@ -185,9 +185,10 @@ fn check_mpm(path: &Path) -> Result<ExitCode> {
 /// machines (docs/performance.md, "MPM×DEM"), for `check`'s run-time estimate.
 const RVE_NS_PER_GRAIN_STEP: f64 = 75.0;
 
-fn run_mpm(path: &Path, out: &Path, volumes: &[[f64; 2]]) -> Result<ExitCode> {
+fn run_mpm(path: &Path, out: Out, volumes: &[[f64; 2]]) -> Result<ExitCode> {
     let s = MpmScenario::from_file(path)?;
     let d = s.derive()?;
+    let out = out.claim()?;
     eprintln!(
         "{}: MPM column collapse, {} points -> {}",
         s.name,
@@ -214,9 +215,10 @@ fn run_mpm(path: &Path, out: &Path, volumes: &[[f64; 2]]) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn run_dem(path: &Path, out: &Path) -> Result<ExitCode> {
+fn run_dem(path: &Path, out: Out) -> Result<ExitCode> {
     let s = DemScenario::from_file(path)?;
     let d = s.derive()?;
+    let out = out.claim()?;
     eprintln!(
         "{}: DEM column collapse, {} grains -> {}",
         s.name,
@@ -244,7 +246,7 @@ fn run_dem(path: &Path, out: &Path) -> Result<ExitCode> {
 
 /// `granflow run`: run a scenario and write its outputs; `volumes`: the places of the representative volumes whose grains every
 /// frame writes (`--rve-frames`, MPM files with `model = "rve"` only).
-pub fn run(path: &Path, out: &Path, volumes: &[[f64; 2]]) -> Result<ExitCode> {
+pub fn run(path: &Path, out: Out, volumes: &[[f64; 2]]) -> Result<ExitCode> {
     let kind = kind_of_file(path)?;
     if !volumes.is_empty() && kind != Kind::Mpm {
         anyhow::bail!(
@@ -266,8 +268,9 @@ pub fn run(path: &Path, out: &Path, volumes: &[[f64; 2]]) -> Result<ExitCode> {
     }
 }
 
-fn run_submerged(path: &Path, out: &Path) -> Result<ExitCode> {
+fn run_submerged(path: &Path, out: Out) -> Result<ExitCode> {
     let s = SubmergedScenario::from_file(path)?;
+    let out = out.claim()?;
     eprintln!("{}: submerged column collapse -> {}", s.name, out.display());
     let r = with_progress((1e3 * s.time.end_tc) as u64, "milli-τ_c", |p| {
         granflow::scenario::collapse::submerged::run_submerged(&s, out, p)
@@ -277,9 +280,10 @@ fn run_submerged(path: &Path, out: &Path) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn run_fluid(path: &Path, out: &Path) -> Result<ExitCode> {
+fn run_fluid(path: &Path, out: Out) -> Result<ExitCode> {
     let s = Scenario::from_file(path)?;
     let d = s.derive()?;
+    let out = out.claim()?;
     eprintln!(
         "{}: {} × {} cells, τ = {:.4}, Mach {:.3}, Re {:.1}, {} steps -> {}",
         s.name,

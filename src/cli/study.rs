@@ -10,7 +10,7 @@ use granflow::scenario::dem::DemScenario;
 use granflow::scenario::validation;
 use granflow::scenario::ScenarioFile;
 
-use super::with_progress;
+use super::{with_progress, Out};
 
 pub fn sweep(path: &Path, out: &Path, jobs: usize) -> Result<ExitCode> {
     let r = granflow::sweep::run_sweep(path, out, jobs)?;
@@ -71,7 +71,7 @@ pub fn sweep(path: &Path, out: &Path, jobs: usize) -> Result<ExitCode> {
 /// `periodic` when given, else the wall-bounded sample.
 pub fn biaxial(
     path: &Path,
-    out: &Path,
+    out: Out,
     [confining, inertial_number, strain]: [f64; 3],
     grains: usize,
     prep_friction: Option<f64>,
@@ -94,6 +94,7 @@ pub fn biaxial(
             strain,
             seed.unwrap_or(s.seed),
         )?;
+        let out = out.claim()?;
         eprintln!(
             "{}: periodic biaxial test, {grains} grains at φ = {phi}, σ₃ = {confining} Pa, I = {inertial_number}, to ε₁ = {strain} -> {}",
             s.name,
@@ -115,6 +116,7 @@ pub fn biaxial(
         prep_friction,
         seed,
     )?;
+    let out = out.claim()?;
     eprintln!(
         "{}: biaxial test, {grains} grains, σ₃ = {confining} Pa, I = {inertial_number}, to ε₁ = {strain} -> {}",
         s.name,
@@ -130,7 +132,7 @@ pub fn biaxial(
 /// `granflow shear`.
 pub fn shear(
     path: &Path,
-    out: &Path,
+    out: Out,
     pressure: f64,
     inertial_numbers: &[f64],
     grains: usize,
@@ -143,6 +145,7 @@ pub fn shear(
         .iter()
         .map(|&i| ShearSpec::from_scenario(&s, grains, pressure, i, strain, seed))
         .collect::<granflow::Result<Vec<_>>>()?;
+    let out = out.claim()?;
     eprintln!(
         "{}: periodic simple shear, {grains} grains, P = {pressure} Pa, I = {inertial_numbers:?}, \
          to γ = {strain} -> {}",

@@ -11,6 +11,7 @@ pub mod csv;
 pub mod json;
 pub mod plot;
 pub mod pvd;
+pub mod run_dir;
 pub mod vtk;
 
 pub use atomic::{write_atomic, write_atomic_bytes};

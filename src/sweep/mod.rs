@@ -74,7 +74,7 @@ fn reusable(case: &Case, dir: &Path) -> Option<CollapseOutcome> {
 
 /// Runs one case in `dir` (see the module doc for reuse).
 fn run_case(case: &Case, dir: &Path, progress: crate::exec::Progress) -> Result<CollapseOutcome> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    crate::io::run_dir::create(dir)?;
     // A stale summary must not survive a run that fails part-way.
     let summary = dir.join("summary.json");
     if summary.exists() {
@@ -131,7 +131,7 @@ pub fn run_sweep(path: &Path, out: &Path, jobs: usize) -> Result<SweepReport> {
         }
         .map_err(|e| Error::Other(format!("case `{}`: {e}", case.name)))?;
     }
-    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    crate::io::run_dir::create(out)?;
     let display = progress::Display::new(&cases);
     let results: Mutex<Vec<Option<CaseResult>>> = Mutex::new(vec![None; cases.len()]);
     let work = || {

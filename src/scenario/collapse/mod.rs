@@ -27,7 +27,7 @@ use serde::Serialize;
 use crate::analysis::runout::{CollapseOutcome, CollapseRecord, EnergyBudget};
 use crate::exec::Progress;
 use crate::io::{write_json, CsvWriter, PvdSeries};
-use crate::{Error, Result};
+use crate::Result;
 
 /// One time-series row of a collapsing column.
 #[derive(Clone, Debug)]
@@ -129,7 +129,7 @@ pub fn run_column<C: Column>(
     out_dir: &Path,
     progress: Progress,
 ) -> Result<C::Summary> {
-    std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
+    crate::io::run_dir::create(out_dir)?;
     let tau_c = plan.tau_c();
     let frame_every = ((plan.frame_interval_tc / plan.series_interval_tc).round() as u64).max(1);
     let mut header = vec!["t", "t_over_tc", "runout", "front", "height"];

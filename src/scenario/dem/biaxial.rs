@@ -363,7 +363,7 @@ pub fn write_biaxial(
     final_strain: f64,
     out_dir: &Path,
 ) -> Result<()> {
-    std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
+    crate::io::run_dir::create(out_dir)?;
     let mut csv = CsvWriter::create(
         &out_dir.join("biaxial.csv"),
         &[

@@ -498,7 +498,7 @@ pub fn run_mu_i_to(specs: &[ShearSpec], out_dir: &Path) -> Result<MuIResult> {
 }
 
 fn write_outputs(r: &MuIResult, out: &Path) -> Result<()> {
-    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    crate::io::run_dir::create(out)?;
     let cols = [
         "strain",
         "sigma_xx",

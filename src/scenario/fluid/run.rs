@@ -19,7 +19,7 @@ use crate::analysis::spectrum::dominant_frequency;
 use crate::io::{write_json, write_vti, CsvWriter, Field, ImageGrid, PvdSeries};
 use crate::lbm::{Fluid, Macroscopic, STOP_MACH};
 use crate::scenario::fluid::{Derived, Scenario};
-use crate::{Error, Result};
+use crate::Result;
 
 /// Most steps between two stability checks.
 const CHECK_EVERY: u64 = 500;
@@ -69,7 +69,7 @@ pub struct Summary {
 /// also written, or the error that stopped the run (after writing the summary with it).
 pub fn run(scenario: &Scenario, out: &Path, progress: crate::exec::Progress) -> Result<Summary> {
     let (mut fluid, derived) = scenario.build()?;
-    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    crate::io::run_dir::create(out)?;
     let mut state = Outputs::create(scenario, &derived, out)?;
     let names: Vec<String> = scenario
         .lattice_obstacles(&derived.units)

@@ -17,12 +17,19 @@
 //! The packing fraction is controlled by the friction used while compacting (the usual
 //! route: frictional compaction gives loose packings, frictionless dense ones). Each
 //! compaction starts from the same dilute state, rests at p₀ with the compaction friction,
-//! then with the material's own friction. The material's friction gives the loosest packing
-//! and none the densest; a target between them is found by bisection on the compaction
-//! friction (at most 10 compactions) to the first packing within the tolerance. A target
-//! outside the reachable range is refused with the range.
+//! then with the material's own friction. The material's friction gives a loose packing and
+//! none the densest; a target between them is found by bisection on the compaction friction
+//! (at most 10 compactions) to the first packing within the tolerance. A target looser than
+//! the material's friction gives is sought the same way between that friction and
+//! [`LOOSEST_FRICTION`] (the friction is restored once compacted, so the grains are the
+//! material's either way). A target outside the reachable range is refused with the range.
 
 use super::{PeriodicCell, Tensor};
+
+/// Compaction friction of the loosest packing tried, when the material's own friction
+/// (if lower) does not compact as loose as the target: frictional compaction up to
+/// μ = 1 is the usual route to loose packings.
+pub const LOOSEST_FRICTION: f64 = 1.0;
 use crate::dem::contact::ContactParams;
 use crate::dem::packing::{SizeDistribution, SplitMix64};
 
@@ -149,39 +156,54 @@ impl Preparation {
     pub fn run(&self) -> Result<Prepared, String> {
         let (target, tol, p0) = (self.packing_fraction, self.tolerance, self.pressure);
         let mu = self.contact.friction;
-        let loose = self.compact(mu)?;
-        let phi_loose = loose.packing_fraction();
-        let mut steps = loose.steps();
+        let own = self.compact(mu)?;
+        let phi_own = own.packing_fraction();
+        let mut steps = own.steps();
         let done = |cell: PeriodicCell, friction: f64, steps: u64| Prepared {
             cell,
             compaction_friction: friction,
             steps,
         };
-        if (phi_loose - target).abs() <= tol {
-            return Ok(done(loose, mu, steps));
+        if (phi_own - target).abs() <= tol {
+            return Ok(done(own, mu, steps));
         }
-        if target < phi_loose {
-            return Err(format!(
-                "packing_fraction = {target} is below the loosest packing this material \
-                 reaches at p₀ = {p0:e} Pa (φ = {phi_loose:.4}, compacted with its own friction)"
-            ));
-        }
-        let dense = self.compact(0.0)?;
-        let phi_dense = dense.packing_fraction();
-        steps += dense.steps();
-        if (phi_dense - target).abs() <= tol {
-            return Ok(done(dense, 0.0, steps));
-        }
-        if target > phi_dense {
-            return Err(format!(
-                "packing_fraction = {target} is above the densest packing reached at \
-                 p₀ = {p0:e} Pa (φ = {phi_dense:.4} compacted frictionless; the loosest is \
-                 {phi_loose:.4})"
-            ));
-        }
+        // The bracket: a compaction friction that gives a packing denser than the target
+        // (with its cell) and one that gives a looser packing.
+        let (dense_end, loose_end) = if target < phi_own {
+            let mu_loose = LOOSEST_FRICTION.max(mu);
+            let loosest = self.compact(mu_loose)?;
+            let phi_loosest = loosest.packing_fraction();
+            steps += loosest.steps();
+            if (phi_loosest - target).abs() <= tol {
+                return Ok(done(loosest, mu_loose, steps));
+            }
+            if target < phi_loosest {
+                return Err(format!(
+                    "packing_fraction = {target} is below the loosest packing this material \
+                     reaches at p₀ = {p0:e} Pa (φ = {phi_loosest:.4}, compacted with friction \
+                     {mu_loose}; {phi_own:.4} with its own)"
+                ));
+            }
+            ((mu, own), mu_loose)
+        } else {
+            let dense = self.compact(0.0)?;
+            let phi_dense = dense.packing_fraction();
+            steps += dense.steps();
+            if (phi_dense - target).abs() <= tol {
+                return Ok(done(dense, 0.0, steps));
+            }
+            if target > phi_dense {
+                return Err(format!(
+                    "packing_fraction = {target} is above the densest packing reached at \
+                     p₀ = {p0:e} Pa (φ = {phi_dense:.4} compacted frictionless; with the \
+                     material's friction {phi_own:.4})"
+                ));
+            }
+            ((0.0, dense), mu)
+        };
         // Bisection on the compaction friction: φ falls as it rises.
-        let (mut lo, mut hi) = (0.0, mu);
-        let mut best = (f64::INFINITY, dense, 0.0);
+        let ((mut lo, dense), mut hi) = (dense_end, loose_end);
+        let mut best = (f64::INFINITY, dense, lo);
         for _ in 0..10 {
             let mid = 0.5 * (lo + hi);
             let cell = self.compact(mid)?;

@@ -1,5 +1,5 @@
-//! Execution helpers shared by the solvers and the runners: progress callbacks, thread pools
-//! and the median of timed repeats.
+//! Execution helpers shared by the solvers and the runners: progress callbacks, thread pools,
+//! the median of timed repeats and the memory a run may take.
 
 use crate::{Error, Result};
 
@@ -21,6 +21,35 @@ pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> Result<R> + Send)
         .map_err(|e| Error::Other(format!("thread pool: {e}")))?
         .install(f)
 }
+
+/// Memory the machine can give a new process now (bytes): `MemAvailable` of `/proc/meminfo`;
+/// `None` where that is not known (not Linux).
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Refuses a run whose estimated peak memory `need` (bytes) exceeds what the machine has
+/// available, naming both.
+pub fn check_memory(need: u64) -> Result<()> {
+    match available_memory() {
+        Some(have) if need > have => Err(crate::Error::config(
+            "memory",
+            format!(
+                "the run needs about {:.1} GiB at its peak and this machine has {:.1} GiB \
+                 available: use a coarser grid or fewer grains, or a larger machine",
+                need as f64 / GIB,
+                have as f64 / GIB
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Bytes in a GiB.
+pub const GIB: f64 = (1u64 << 30) as f64;
 
 #[cfg(test)]
 mod tests {

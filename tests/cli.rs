@@ -508,3 +508,38 @@ fn an_earlier_run_is_refused_unless_forced() {
     assert!(err.contains("not a granflow run folder"), "{err}");
     assert!(mine.join("notes.txt").exists());
 }
+
+/// A run larger than the machine's memory is refused before anything is allocated or written,
+/// naming what it needs and what the machine has (issue 24); `check` prints the estimate.
+/// The channel at 10⁴ times its area needs about 4 TiB (1.28 × 10¹⁰ cells at 331 bytes).
+#[test]
+fn a_run_larger_than_memory_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(data("tiny_channel.toml"))
+        .unwrap()
+        .replace("size = [0.005, 0.01]", "size = [50.0, 100.0]");
+    let scenario = dir.path().join("huge.toml");
+    std::fs::write(&scenario, text).unwrap();
+    let check = granflow().arg("check").arg(&scenario).output().unwrap();
+    let report = String::from_utf8_lossy(&check.stdout);
+    assert!(
+        report.contains("MiB at the peak"),
+        "{report}{}",
+        String::from_utf8_lossy(&check.stderr)
+    );
+    let out_dir = dir.path().join("out");
+    let run = granflow()
+        .arg("run")
+        .arg(&scenario)
+        .arg("--out")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(!run.status.success());
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        err.contains("memory") && err.contains("GiB available"),
+        "{err}"
+    );
+    assert!(!out_dir.exists());
+}

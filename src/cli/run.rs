@@ -91,7 +91,7 @@ fn check_fluid(path: &Path) -> Result<ExitCode> {
     }
     println!("precision       {:?}", s.lbm.precision);
     println!(
-        "memory          {:.1} MiB (populations)",
+        "memory          about {:.0} MiB at the peak (a frame being written)",
         d.memory_bytes as f64 / (1 << 20) as f64
     );
     println!("obstacles       {}", s.obstacles.len());
@@ -270,6 +270,7 @@ pub fn run(path: &Path, out: Out, volumes: &[[f64; 2]]) -> Result<ExitCode> {
 
 fn run_submerged(path: &Path, out: Out) -> Result<ExitCode> {
     let s = SubmergedScenario::from_file(path)?;
+    granflow::exec::check_memory(s.derive()?.memory_bytes as u64)?;
     let out = out.claim()?;
     eprintln!("{}: submerged column collapse -> {}", s.name, out.display());
     let r = with_progress((1e3 * s.time.end_tc) as u64, "milli-τ_c", |p| {
@@ -283,6 +284,7 @@ fn run_submerged(path: &Path, out: Out) -> Result<ExitCode> {
 fn run_fluid(path: &Path, out: Out) -> Result<ExitCode> {
     let s = Scenario::from_file(path)?;
     let d = s.derive()?;
+    granflow::exec::check_memory(d.memory_bytes as u64)?;
     let out = out.claim()?;
     eprintln!(
         "{}: {} × {} cells, τ = {:.4}, Mach {:.3}, Re {:.1}, {} steps -> {}",

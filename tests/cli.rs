@@ -7,6 +7,18 @@ fn granflow() -> Command {
     Command::new(env!("CARGO_BIN_EXE_granflow"))
 }
 
+/// `granflow run SCENARIO --out OUT EXTRA…`.
+fn run_to(scenario: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    granflow()
+        .arg("run")
+        .arg(scenario)
+        .arg("--out")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data")
@@ -111,13 +123,7 @@ fn an_unstable_run_stops_naming_step_and_cell_and_keeps_its_frames() {
     let scenario = dir.path().join("unstable.toml");
     std::fs::write(&scenario, text).unwrap();
     let out_dir = dir.path().join("out");
-    let out = granflow()
-        .arg("run")
-        .arg(&scenario)
-        .arg("--out")
-        .arg(&out_dir)
-        .output()
-        .unwrap();
+    let out = run_to(&scenario, &out_dir, &[]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -454,16 +460,7 @@ fn rve_frames_need_a_representative_volume() {
 fn an_earlier_run_is_refused_unless_forced() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("run");
-    let run = |extra: &[&str]| {
-        granflow()
-            .arg("run")
-            .arg(data("tiny_channel.toml"))
-            .arg("--out")
-            .arg(&out_dir)
-            .args(extra)
-            .output()
-            .unwrap()
-    };
+    let run = |extra: &[&str]| run_to(&data("tiny_channel.toml"), &out_dir, extra);
     let first = run(&[]);
     assert!(
         first.status.success(),
@@ -495,14 +492,7 @@ fn an_earlier_run_is_refused_unless_forced() {
     let mine = dir.path().join("mine");
     std::fs::create_dir(&mine).unwrap();
     std::fs::write(mine.join("notes.txt"), "keep").unwrap();
-    let refused = granflow()
-        .arg("run")
-        .arg(data("tiny_channel.toml"))
-        .arg("--out")
-        .arg(&mine)
-        .arg("--force")
-        .output()
-        .unwrap();
+    let refused = run_to(&data("tiny_channel.toml"), &mine, &["--force"]);
     assert!(!refused.status.success());
     let err = String::from_utf8_lossy(&refused.stderr);
     assert!(err.contains("not a granflow run folder"), "{err}");
@@ -528,13 +518,7 @@ fn a_run_larger_than_memory_is_refused() {
         String::from_utf8_lossy(&check.stderr)
     );
     let out_dir = dir.path().join("out");
-    let run = granflow()
-        .arg("run")
-        .arg(&scenario)
-        .arg("--out")
-        .arg(&out_dir)
-        .output()
-        .unwrap();
+    let run = run_to(&scenario, &out_dir, &[]);
     assert!(!run.status.success());
     let err = String::from_utf8_lossy(&run.stderr);
     assert!(

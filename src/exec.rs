@@ -48,6 +48,15 @@ pub fn check_memory(need: u64) -> Result<()> {
     }
 }
 
+/// `about N MiB at the peak (M MiB available)`: an estimated peak beside what the machine has.
+pub fn memory_line(need: usize) -> String {
+    let mib = |b: f64| b / (1u64 << 20) as f64;
+    let have = available_memory().map_or(String::new(), |a| {
+        format!(" ({:.0} MiB available)", mib(a as f64))
+    });
+    format!("about {:.0} MiB at the peak{have}", mib(need as f64))
+}
+
 /// Bytes in a GiB.
 pub const GIB: f64 = (1u64 << 30) as f64;
 

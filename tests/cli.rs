@@ -387,6 +387,7 @@ fn check_reports_and_refuses_representative_volumes() {
         "sub-steps per MPM step",
         "run time",
         "geostatic stress (K₀ = 0.69)",
+        "MiB at the peak",
     ] {
         assert!(text.contains(e), "expected `{e}` in: {text}");
     }

@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 
+use granflow::scenario::dem::spec::dem_memory;
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::fluid::Scenario;
 use granflow::scenario::mpm::spec::Law;
@@ -90,13 +91,15 @@ fn check_fluid(path: &Path) -> Result<ExitCode> {
         );
     }
     println!("precision       {:?}", s.lbm.precision);
-    println!(
-        "memory          about {:.0} MiB at the peak (a frame being written)",
-        d.memory_bytes as f64 / (1 << 20) as f64
-    );
+    print_memory(d.memory_bytes);
     println!("obstacles       {}", s.obstacles.len());
     println!("ok");
     Ok(ExitCode::SUCCESS)
+}
+
+/// The `memory` line of `check`: the estimated peak and what the machine has.
+fn print_memory(bytes: usize) {
+    println!("memory          {}", granflow::exec::memory_line(bytes));
 }
 
 fn check_dem(path: &Path) -> Result<ExitCode> {
@@ -112,6 +115,7 @@ fn check_dem(path: &Path) -> Result<ExitCode> {
         s.column.width, d.target_height
     );
     println!("tau_c (target)  {:.4e} s", d.target_tau_c);
+    print_memory(dem_memory(d.grains));
     println!(
         "dt              {:.4e} s (λ·Δt_cr, λ = {}, Δt_cr = {:.4e} s for d_min; the drawn grains may allow more)",
         d.time_step.dt, d.params.lambda, d.time_step.critical
@@ -146,6 +150,7 @@ fn check_mpm(path: &Path) -> Result<ExitCode> {
     if let Some(dt) = s.time.dt {
         println!("dt              {dt:.4e} s (given)");
     }
+    print_memory(d.memory_bytes());
     if let Law::Volume(v) = &d.material {
         let p = &v.preparation;
         let dt = s.time.dt.unwrap_or(d.dt_cfl);
@@ -188,6 +193,7 @@ const RVE_NS_PER_GRAIN_STEP: f64 = 75.0;
 fn run_mpm(path: &Path, out: Out, volumes: &[[f64; 2]]) -> Result<ExitCode> {
     let s = MpmScenario::from_file(path)?;
     let d = s.derive()?;
+    granflow::exec::check_memory(d.memory_bytes() as u64)?;
     let out = out.claim()?;
     eprintln!(
         "{}: MPM column collapse, {} points -> {}",
@@ -218,6 +224,7 @@ fn run_mpm(path: &Path, out: Out, volumes: &[[f64; 2]]) -> Result<ExitCode> {
 fn run_dem(path: &Path, out: Out) -> Result<ExitCode> {
     let s = DemScenario::from_file(path)?;
     let d = s.derive()?;
+    granflow::exec::check_memory(dem_memory(d.grains) as u64)?;
     let out = out.claim()?;
     eprintln!(
         "{}: DEM column collapse, {} grains -> {}",

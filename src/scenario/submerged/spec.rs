@@ -363,13 +363,7 @@ impl SubmergedScenario {
                 steps * d.subcycles as f64
             ),
         );
-        line(
-            "memory",
-            format!(
-                "about {:.0} MiB at the peak (a frame being written)",
-                d.memory_bytes as f64 / (1u64 << 20) as f64
-            ),
-        );
+        line("memory", crate::exec::memory_line(d.memory_bytes));
         r.push_str("ok\n");
         Ok(r)
     }

@@ -44,10 +44,13 @@ pub struct Out<'a> {
 }
 
 impl<'a> Out<'a> {
-    /// The folder, once it is known to take the run ([`granflow::io::run_dir::prepare`]:
-    /// an earlier run in it refused, or deleted with `--force`); call it after the input has
-    /// been checked, so that a refused input leaves an earlier run alone.
-    fn claim(self) -> granflow::Result<&'a Path> {
+    /// The folder, once the machine is known to have the run's estimated peak memory
+    /// `memory` (bytes, [`granflow::exec::check_memory`]) and the folder to take the run
+    /// ([`granflow::io::run_dir::prepare`]: an earlier run in it refused, or deleted with
+    /// `--force`); call it after the input has been checked, so that a refused input leaves
+    /// an earlier run alone.
+    fn claim(self, memory: usize) -> granflow::Result<&'a Path> {
+        granflow::exec::check_memory(memory as u64)?;
         granflow::io::run_dir::prepare(self.dir, self.force)?;
         Ok(self.dir)
     }

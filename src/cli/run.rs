@@ -193,8 +193,7 @@ const RVE_NS_PER_GRAIN_STEP: f64 = 75.0;
 fn run_mpm(path: &Path, out: Out, volumes: &[[f64; 2]]) -> Result<ExitCode> {
     let s = MpmScenario::from_file(path)?;
     let d = s.derive()?;
-    granflow::exec::check_memory(d.memory_bytes() as u64)?;
-    let out = out.claim()?;
+    let out = out.claim(d.memory_bytes())?;
     eprintln!(
         "{}: MPM column collapse, {} points -> {}",
         s.name,
@@ -224,8 +223,7 @@ fn run_mpm(path: &Path, out: Out, volumes: &[[f64; 2]]) -> Result<ExitCode> {
 fn run_dem(path: &Path, out: Out) -> Result<ExitCode> {
     let s = DemScenario::from_file(path)?;
     let d = s.derive()?;
-    granflow::exec::check_memory(dem_memory(d.grains) as u64)?;
-    let out = out.claim()?;
+    let out = out.claim(dem_memory(d.grains))?;
     eprintln!(
         "{}: DEM column collapse, {} grains -> {}",
         s.name,
@@ -277,8 +275,7 @@ pub fn run(path: &Path, out: Out, volumes: &[[f64; 2]]) -> Result<ExitCode> {
 
 fn run_submerged(path: &Path, out: Out) -> Result<ExitCode> {
     let s = SubmergedScenario::from_file(path)?;
-    granflow::exec::check_memory(s.derive()?.memory_bytes as u64)?;
-    let out = out.claim()?;
+    let out = out.claim(s.derive()?.memory_bytes)?;
     eprintln!("{}: submerged column collapse -> {}", s.name, out.display());
     let r = with_progress((1e3 * s.time.end_tc) as u64, "milli-τ_c", |p| {
         granflow::scenario::collapse::submerged::run_submerged(&s, out, p)
@@ -291,8 +288,7 @@ fn run_submerged(path: &Path, out: Out) -> Result<ExitCode> {
 fn run_fluid(path: &Path, out: Out) -> Result<ExitCode> {
     let s = Scenario::from_file(path)?;
     let d = s.derive()?;
-    granflow::exec::check_memory(d.memory_bytes as u64)?;
-    let out = out.claim()?;
+    let out = out.claim(d.memory_bytes)?;
     eprintln!(
         "{}: {} × {} cells, τ = {:.4}, Mach {:.3}, Re {:.1}, {} steps -> {}",
         s.name,

@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 
 use granflow::report::{Check, Fidelity};
+use granflow::scenario::dem::spec::dem_memory;
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::validation;
 use granflow::scenario::ScenarioFile;
@@ -94,7 +95,7 @@ pub fn biaxial(
             strain,
             seed.unwrap_or(s.seed),
         )?;
-        let out = out.claim()?;
+        let out = out.claim(dem_memory(grains))?;
         eprintln!(
             "{}: periodic biaxial test, {grains} grains at φ = {phi}, σ₃ = {confining} Pa, I = {inertial_number}, to ε₁ = {strain} -> {}",
             s.name,
@@ -116,7 +117,7 @@ pub fn biaxial(
         prep_friction,
         seed,
     )?;
-    let out = out.claim()?;
+    let out = out.claim(dem_memory(grains))?;
     eprintln!(
         "{}: biaxial test, {grains} grains, σ₃ = {confining} Pa, I = {inertial_number}, to ε₁ = {strain} -> {}",
         s.name,
@@ -145,7 +146,7 @@ pub fn shear(
         .iter()
         .map(|&i| ShearSpec::from_scenario(&s, grains, pressure, i, strain, seed))
         .collect::<granflow::Result<Vec<_>>>()?;
-    let out = out.claim()?;
+    let out = out.claim(dem_memory(grains))?;
     eprintln!(
         "{}: periodic simple shear, {grains} grains, P = {pressure} Pa, I = {inertial_numbers:?}, \
          to γ = {strain} -> {}",

@@ -165,7 +165,6 @@ pub(crate) enum Collision {
 
 #[derive(Subcommand)]
 pub(crate) enum Bench {
-    /// GIMPM step on a collapsing column, in material point-steps per second.
     /// The MPM×DEM material: µs per point per MPM step and ns per grain per DEM sub-step of
     /// the representative volume of an MPM scenario with `model = "rve"`.
     Rve {
@@ -187,6 +186,7 @@ pub(crate) enum Bench {
         #[arg(long)]
         json: bool,
     },
+    /// GIMPM step on a collapsing column, in material point-steps per second.
     Mpm {
         /// Material points (about; the column is w × 2w cells with 4 points per cell).
         #[arg(long, default_value_t = 8192)]

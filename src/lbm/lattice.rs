@@ -39,6 +39,16 @@ fn bulk_lanes<T>() -> usize {
     128 / std::mem::size_of::<T>()
 }
 
+/// The bulk loop at [`bulk_lanes`] lanes, compiled for this CPU's vector extensions
+/// ([`super::simd`]).
+fn bulk_kernel_for<T: Real>() -> super::simd::BulkFn<T> {
+    if bulk_lanes::<T>() == 32 {
+        super::simd::bulk_kernel::<T, 32>()
+    } else {
+        super::simd::bulk_kernel::<T, 16>()
+    }
+}
+
 /// Covered cells per chunk of the partially saturated path, in either precision. Covered
 /// stretches are short (a disk's chord, ≈ 34 cells at the bench's 21-cell radius), and a
 /// chunk's unused lanes are collided all the same: 8 wastes ≈ 11 % of the lanes where 32
@@ -402,6 +412,7 @@ impl<T: Real> Lattice<T> {
         let base = Shared(self.f.as_mut_ptr());
         let specials = &self.specials;
         let wall_corr = &self.wall_corr;
+        let bulk = bulk_kernel_for::<T>();
         self.rows.par_iter().enumerate().for_each(|(y, plan)| {
             let (runs, group_list) = if even {
                 (&plan.even_runs, &plan.even_specials)
@@ -413,13 +424,7 @@ impl<T: Real> Lattice<T> {
                 // module docs); bulk nodes of row y touch slots of their own node (even) or of
                 // their 8 in-domain neighbours (odd), which no other node touches.
                 let (f, x0, x1) = (base.get(), x0 as usize, x1 as usize);
-                unsafe {
-                    if bulk_lanes::<T>() == 32 {
-                        bulk_run::<T, 32>(f, n, nx, ny, y, x0, x1, even, collider)
-                    } else {
-                        bulk_run::<T, 16>(f, n, nx, ny, y, x0, x1, even, collider)
-                    }
-                };
+                unsafe { bulk(f, n, nx, ny, y, x0, x1, even, collider) };
             }
             for group in group_list.chunks(LANES) {
                 // SAFETY: as above; special nodes touch only their own link slots.
@@ -486,6 +491,7 @@ impl<T: Real> Lattice<T> {
         let (specials, special_of, solid) = (&self.specials, &self.special_of, &self.solid);
         let wall_corr = &self.wall_corr;
         let row_start = &self.covered_rows;
+        let bulk_fn = bulk_kernel_for::<T>();
         self.rows.par_iter().enumerate().for_each(|(y, plan)| {
             let (runs, group_list) = if even {
                 (&plan.even_runs, &plan.even_specials)
@@ -498,13 +504,7 @@ impl<T: Real> Lattice<T> {
             let row = (y * nx) as u32;
             let bulk = |x0: usize, x1: usize| {
                 // SAFETY: as in `step`.
-                unsafe {
-                    if bulk_lanes::<T>() == 32 {
-                        bulk_run::<T, 32>(base.get(), n, nx, ny, y, x0, x1, even, collider)
-                    } else {
-                        bulk_run::<T, 16>(base.get(), n, nx, ny, y, x0, x1, even, collider)
-                    }
-                }
+                unsafe { bulk_fn(base.get(), n, nx, ny, y, x0, x1, even, collider) }
             };
             // Bulk runs, cut around the covered cells.
             for &(x0, x1) in runs {
@@ -804,7 +804,7 @@ impl<T: Real> Lattice<T> {
 /// their link slots during this step.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-unsafe fn bulk_run<T: Real, const L: usize>(
+pub(super) unsafe fn bulk_run<T: Real, const L: usize>(
     f: *mut T,
     n: usize,
     nx: usize,

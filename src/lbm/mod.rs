@@ -17,6 +17,7 @@ pub mod d2q9;
 pub mod lattice;
 pub mod obstacle;
 pub mod real;
+pub mod simd;
 pub mod solver;
 
 pub use boundary::{Edge, Edges};

@@ -261,7 +261,7 @@ impl Sample {
     /// until, over a block of them, both mean stresses are within 1 % of σ₃ and the kinetic
     /// energy of the load-carrying grains ([`Dem::loaded_kinetic_energy`]) is below
     /// 1e-7 σ₃ d̄² t per grain. Rattlers are left out: a grain with no contact spinning freely
-    /// holds its energy for ever (seen: one such grain held 84 % of a 960-grain sample's
+    /// holds its energy for ever (seen: one such grain held 84 % of a 1000-grain sample's
     /// kinetic energy, 1.6× the threshold, while the wall stresses were at σ₃ to 0.01 %).
     fn consolidate(&mut self, sigma_3: f64, d_mean: f64, v_max: f64, max_time: f64) -> Result<()> {
         let rest = 1e-7 * sigma_3 * d_mean * d_mean * self.thickness * self.dem.grains.len() as f64;

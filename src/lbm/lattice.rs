@@ -17,9 +17,11 @@
 //! fluid node but the Zou–He ones takes the vectorised loop. Links into obstacles are listed with their wall distance q so that
 //! [`super::obstacle`] can apply interpolated bounce-back and momentum exchange after the step.
 //!
-//! Length: the unsafe kernels (bulk, special and covered nodes, even and odd steps) share the
+//! Length: the unsafe kernels (special and covered nodes, even and odd steps) share the
 //! private layout and rest on one safety argument (each slot is read and written by exactly
 //! one node per step); they stay in one file so that argument can be checked in one place.
+//! The bulk loop, compiled once per vector extension, is in [`super::simd`] under the same
+//! contract.
 
 use rayon::prelude::*;
 
@@ -797,75 +799,12 @@ impl<T: Real> Lattice<T> {
     }
 }
 
-/// Collide one run of bulk nodes of row `y`.
-///
-/// # Safety
-/// `f` points to `Q·n` values; `x0..x1` are bulk nodes of row `y` and no other thread touches
-/// their link slots during this step.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-pub(super) unsafe fn bulk_run<T: Real, const L: usize>(
-    f: *mut T,
-    n: usize,
-    nx: usize,
-    ny: usize,
-    y: usize,
-    x0: usize,
-    x1: usize,
-    even: bool,
-    collider: &Collider<T>,
-) {
-    // Offset of the slot each direction uses, relative to the node's own index.
-    let row = y * nx;
-    let offs: [usize; Q] = std::array::from_fn(|i| {
-        if even {
-            i * n + row
-        } else {
-            let yy = (y as i64 + CY[i] as i64).rem_euclid(ny as i64) as usize;
-            ((i * n + yy * nx) as i64 + CX[i] as i64) as usize
-        }
-    });
-    let mut x = x0;
-    let mut buf = [[T::zero(); L]; Q];
-    // Full chunks: fixed-size loads and stores the compiler turns into vector moves.
-    while x + L <= x1 {
-        for i in 0..Q {
-            // Even: f_i = A[x][i]. Odd: slot of direction i holds f_ī.
-            let dst = if even { i } else { OPP[i] };
-            buf[dst] = std::ptr::read_unaligned(f.add(offs[i] + x) as *const [T; L]);
-        }
-        collider.collide(&mut buf);
-        for i in 0..Q {
-            // Even: A[x][ī] = f_i*. Odd: A[x + e_i][i] = f_i*.
-            let slot = if even { OPP[i] } else { i };
-            std::ptr::write_unaligned(f.add(offs[slot] + x) as *mut [T; L], buf[i]);
-        }
-        x += L;
-    }
-    // Remainder, padded with copies of its first cell.
-    if x < x1 {
-        let len = x1 - x;
-        for i in 0..Q {
-            let dst = if even { i } else { OPP[i] };
-            std::ptr::copy_nonoverlapping(f.add(offs[i] + x), buf[dst].as_mut_ptr(), len);
-            for l in len..L {
-                buf[dst][l] = buf[dst][0];
-            }
-        }
-        collider.collide(&mut buf);
-        for i in 0..Q {
-            let slot = if even { OPP[i] } else { i };
-            std::ptr::copy_nonoverlapping(buf[i].as_ptr(), f.add(offs[slot] + x), len);
-        }
-    }
-}
-
 /// Collide a stretch `x0..x1` of covered bulk nodes of row `y` (the cells of `psm` from entry
-/// `k0` on) as in [`bulk_run`], with the covered-cell term [`CoveredCells::apply`], and
-/// store the exchanged momentum at `exchange[k0..]`.
+/// `k0` on) as in [`super::simd::bulk_run`], with the covered-cell term
+/// [`CoveredCells::apply`], and store the exchanged momentum at `exchange[k0..]`.
 ///
 /// # Safety
-/// As [`bulk_run`]; entries `k0..k0 + x1 − x0` of `exchange` belong to this call.
+/// As [`super::simd::bulk_run`]; entries `k0..k0 + x1 − x0` of `exchange` belong to this call.
 #[allow(clippy::too_many_arguments)]
 unsafe fn bulk_run_psm<T: Real, C: CoveredCells<T>, const L: usize>(
     f: *mut T,
@@ -972,7 +911,7 @@ unsafe fn gather<T: Real>(
 /// Stream–collide a group of at most [`LANES`] special nodes of one row.
 ///
 /// # Safety
-/// As [`bulk_run`]; `group` indexes `specials`.
+/// As [`super::simd::bulk_run`]; `group` indexes `specials`.
 #[allow(clippy::too_many_arguments)]
 unsafe fn special_nodes<T: Real>(
     f: *mut T,

@@ -11,8 +11,71 @@
 //! numbers bit for bit: `mul_add` is fused at every level.
 
 use super::collision::Collider;
-use super::lattice::bulk_run;
+use super::d2q9::{CX, CY, OPP, Q};
 use super::real::Real;
+
+/// Collide one run of bulk nodes of row `y` (the AA pattern of [`super::lattice`]).
+///
+/// # Safety
+/// `f` points to `Q·n` values; `x0..x1` are bulk nodes of row `y` and no other thread touches
+/// their link slots during this step.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) unsafe fn bulk_run<T: Real, const L: usize>(
+    f: *mut T,
+    n: usize,
+    nx: usize,
+    ny: usize,
+    y: usize,
+    x0: usize,
+    x1: usize,
+    even: bool,
+    collider: &Collider<T>,
+) {
+    // Offset of the slot each direction uses, relative to the node's own index.
+    let row = y * nx;
+    let offs: [usize; Q] = std::array::from_fn(|i| {
+        if even {
+            i * n + row
+        } else {
+            let yy = (y as i64 + CY[i] as i64).rem_euclid(ny as i64) as usize;
+            ((i * n + yy * nx) as i64 + CX[i] as i64) as usize
+        }
+    });
+    let mut x = x0;
+    let mut buf = [[T::zero(); L]; Q];
+    // Full chunks: fixed-size loads and stores the compiler turns into vector moves.
+    while x + L <= x1 {
+        for i in 0..Q {
+            // Even: f_i = A[x][i]. Odd: slot of direction i holds f_ī.
+            let dst = if even { i } else { OPP[i] };
+            buf[dst] = std::ptr::read_unaligned(f.add(offs[i] + x) as *const [T; L]);
+        }
+        collider.collide(&mut buf);
+        for i in 0..Q {
+            // Even: A[x][ī] = f_i*. Odd: A[x + e_i][i] = f_i*.
+            let slot = if even { OPP[i] } else { i };
+            std::ptr::write_unaligned(f.add(offs[slot] + x) as *mut [T; L], buf[i]);
+        }
+        x += L;
+    }
+    // Remainder, padded with copies of its first cell.
+    if x < x1 {
+        let len = x1 - x;
+        for i in 0..Q {
+            let dst = if even { i } else { OPP[i] };
+            std::ptr::copy_nonoverlapping(f.add(offs[i] + x), buf[dst].as_mut_ptr(), len);
+            for l in len..L {
+                buf[dst][l] = buf[dst][0];
+            }
+        }
+        collider.collide(&mut buf);
+        for i in 0..Q {
+            let slot = if even { OPP[i] } else { i };
+            std::ptr::copy_nonoverlapping(buf[i].as_ptr(), f.add(offs[slot] + x), len);
+        }
+    }
+}
 
 /// Signature of the bulk loop: populations, stride, nx, ny, row, first and end node, even
 /// step, collision.

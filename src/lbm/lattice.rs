@@ -820,6 +820,9 @@ unsafe fn bulk_run_psm<T: Real, C: CoveredCells<T>, const L: usize>(
     k0: usize,
     exchange: *mut [f64; 2],
 ) {
+    // The same offsets as `simd::bulk_run`, written out: a shared helper (with the bulk
+    // variants made by a macro) ran the f32 BGK bench 15 % slower (2026-12-04, ≈ 455 against
+    // ≈ 540 MLUPS, three alternated rounds).
     let row = y * nx;
     let offs: [usize; Q] = std::array::from_fn(|i| {
         if even {

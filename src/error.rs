@@ -52,9 +52,39 @@ pub enum Error {
         /// Why, and what to do instead.
         reason: String,
     },
+    /// A run was asked to stop (SIGINT, SIGTERM) and stopped at a step boundary with its
+    /// state saved.
+    #[error(
+        "stopped by {} at step {step} (t = {time:.6e} s); its state is saved in {}: continue \
+         with `granflow resume {}`",
+        signal_name(*.signal),
+        .checkpoint.display(),
+        .out.display()
+    )]
+    Interrupted {
+        /// The signal's number (SIGINT 2, SIGTERM 15).
+        signal: i32,
+        /// Steps taken.
+        step: u64,
+        /// Simulated time in seconds.
+        time: f64,
+        /// The checkpoint written.
+        checkpoint: PathBuf,
+        /// The run's output folder.
+        out: PathBuf,
+    },
     /// Anything else, with a message.
     #[error("{0}")]
     Other(String),
+}
+
+/// `SIGINT`, `SIGTERM`, or `signal N` for another number.
+pub fn signal_name(signal: i32) -> String {
+    match signal {
+        2 => "SIGINT".into(),
+        15 => "SIGTERM".into(),
+        n => format!("signal {n}"),
+    }
 }
 
 /// Library result type.

@@ -44,6 +44,19 @@ enum Command {
         /// with model = "rve"; repeat for more volumes).
         #[arg(long = "rve-frames", value_name = "X,Y", value_parser = parse_place)]
         rve_frames: Vec<[f64; 2]>,
+        /// Save the run's state every SECONDS of simulated time (the newest two checkpoints
+        /// are kept, and removed when the run completes), so that `granflow resume` can
+        /// continue it after a crash or a kill (fluid scenarios). SIGINT or SIGTERM always
+        /// save one before the run stops.
+        #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+        checkpoint_every: Option<f64>,
+    },
+    /// Continue a run from the newest checkpoint in its output folder (one stopped by SIGINT,
+    /// SIGTERM, a crash or a kill), with the scenario it keeps there; the outputs end as an
+    /// uninterrupted run's would.
+    Resume {
+        /// The run's output folder.
+        out: PathBuf,
     },
     /// Run validation cases against their references.
     Validate {
@@ -283,7 +296,13 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");
-            ExitCode::FAILURE
+            // A run stopped by a signal exits as the shell reports a process it killed.
+            match e.chain().find_map(|c| c.downcast_ref::<granflow::Error>()) {
+                Some(granflow::Error::Interrupted { signal, .. }) => {
+                    ExitCode::from((128 + signal) as u8)
+                }
+                _ => ExitCode::FAILURE,
+            }
         }
     }
 }
@@ -313,7 +332,14 @@ fn real_main() -> Result<ExitCode> {
             out,
             force,
             rve_frames,
-        } => cli::run::run(&scenario, out_of(&out, force), &rve_frames),
+            checkpoint_every,
+        } => cli::run::run(
+            &scenario,
+            out_of(&out, force),
+            &rve_frames,
+            checkpoint_every,
+        ),
+        Command::Resume { out } => cli::run::resume(&out),
         Command::Validate {
             case,
             json,

@@ -10,6 +10,8 @@ pub mod study;
 
 use std::io::IsTerminal;
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, AtomicUsize};
+use std::sync::Arc;
 
 /// Run `f` with a progress callback: an indicatif bar on a terminal, a plain line every 10 %
 /// otherwise (logs, CI).
@@ -32,6 +34,21 @@ fn with_progress<R>(total: u64, unit: &str, f: impl FnOnce(&mut dyn FnMut(u64, u
             }
         })
     }
+}
+
+/// The flag SIGINT and SIGTERM set to their number from now on: a run that reads it stops at
+/// its next step boundary, saves a checkpoint and exits with 128 + the number; a second signal
+/// ends the process at once (the same exit code, nothing more saved).
+fn stop_on_signals() -> std::io::Result<Arc<AtomicUsize>> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let stop = Arc::new(AtomicUsize::new(0));
+    let asked = Arc::new(AtomicBool::new(false));
+    for signal in [SIGINT, SIGTERM] {
+        signal_hook::flag::register_conditional_shutdown(signal, 128 + signal, Arc::clone(&asked))?;
+        signal_hook::flag::register(signal, Arc::clone(&asked))?;
+        signal_hook::flag::register_usize(signal, Arc::clone(&stop), signal as usize)?;
+    }
+    Ok(stop)
 }
 
 /// The output folder of a command that writes a run: `--out` and `--force`.

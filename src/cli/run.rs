@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 
+use granflow::scenario::checkpointing::{Control, SCENARIO_COPY};
 use granflow::scenario::dem::spec::dem_memory;
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::fluid::Scenario;
@@ -249,9 +250,15 @@ fn run_dem(path: &Path, out: Out) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// `granflow run`: run a scenario and write its outputs; `volumes`: the places of the representative volumes whose grains every
-/// frame writes (`--rve-frames`, MPM files with `model = "rve"` only).
-pub fn run(path: &Path, out: Out, volumes: &[[f64; 2]]) -> Result<ExitCode> {
+/// `granflow run`: run a scenario and write its outputs; `volumes`: the places of the
+/// representative volumes whose grains every frame writes (`--rve-frames`, MPM files with
+/// `model = "rve"` only); `checkpoint_every`: simulated seconds between checkpoints.
+pub fn run(
+    path: &Path,
+    out: Out,
+    volumes: &[[f64; 2]],
+    checkpoint_every: Option<f64>,
+) -> Result<ExitCode> {
     let kind = kind_of_file(path)?;
     if !volumes.is_empty() && kind != Kind::Mpm {
         anyhow::bail!(
@@ -260,8 +267,23 @@ pub fn run(path: &Path, out: Out, volumes: &[[f64; 2]]) -> Result<ExitCode> {
             path.display()
         );
     }
+    if checkpoint_every.is_some() && !RESUMABLE.contains(&kind) {
+        anyhow::bail!(
+            "--checkpoint-every: {} is a `{kind}` scenario, and only {} runs write checkpoints \
+             so far",
+            path.display(),
+            RESUMABLE.map(|k| format!("`{k}`")).join(", ")
+        );
+    }
     match kind {
-        Kind::Fluid => run_fluid(path, out),
+        Kind::Fluid => {
+            let text = read_text(path)?;
+            let control = Control::new(&text, checkpoint_every, super::stop_on_signals()?)?;
+            let s = Scenario::from_file(path)?;
+            let dir = out.claim(s.derive()?.memory_bytes)?;
+            keep_scenario(dir, &text)?;
+            run_fluid(&s, path, dir, control)
+        }
         Kind::Dem => run_dem(path, out),
         Kind::Mpm => run_mpm(path, out, volumes),
         Kind::Submerged => run_submerged(path, out),
@@ -285,10 +307,65 @@ fn run_submerged(path: &Path, out: Out) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn run_fluid(path: &Path, out: Out) -> Result<ExitCode> {
-    let s = Scenario::from_file(path)?;
+/// The kinds whose runs write checkpoints and stop cleanly on SIGINT/SIGTERM.
+const RESUMABLE: [Kind; 1] = [Kind::Fluid];
+
+fn read_text(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+}
+
+/// Keep the scenario text in the run's folder ([`SCENARIO_COPY`]): what `resume` runs.
+fn keep_scenario(dir: &Path, text: &str) -> Result<()> {
+    granflow::io::run_dir::create(dir)?;
+    granflow::io::write_atomic_bytes(&dir.join(SCENARIO_COPY), text.as_bytes())?;
+    Ok(())
+}
+
+/// `granflow resume DIR`: continue the run in `dir` from its newest checkpoint.
+pub fn resume(dir: &Path) -> Result<ExitCode> {
+    let path = dir.join(SCENARIO_COPY);
+    if !path.is_file() {
+        anyhow::bail!(
+            "cannot resume {}: it holds no run ({SCENARIO_COPY}, which `granflow run` keeps in \
+             its output folder, is missing)",
+            dir.display()
+        );
+    }
+    let text = read_text(&path)?;
+    let kind = granflow::scenario::kind_of(&text)?;
+    let checkpoints = granflow::io::checkpoint::list(dir)?;
+    if checkpoints.is_empty() && completed(dir) {
+        anyhow::bail!(
+            "nothing to resume in {}: its run completed (summary.json)",
+            dir.display()
+        );
+    }
+    let mut control = Control::new(&text, None, super::stop_on_signals()?)?;
+    control.resume = true;
+    match kind {
+        Kind::Fluid => {
+            let s = Scenario::from_file(&path)?;
+            granflow::exec::check_memory(s.derive()?.memory_bytes as u64)?;
+            run_fluid(&s, &path, dir, control)
+        }
+        other => anyhow::bail!(
+            "cannot resume {}: it holds a `{other}` run, and only {} runs write checkpoints so far",
+            dir.display(),
+            RESUMABLE.map(|k| format!("`{k}`")).join(", ")
+        ),
+    }
+}
+
+/// Does the run in `dir` say it completed?
+fn completed(dir: &Path) -> bool {
+    std::fs::read_to_string(dir.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .is_some_and(|v| v["status"] == "completed")
+}
+
+fn run_fluid(s: &Scenario, path: &Path, out: &Path, control: Control) -> Result<ExitCode> {
     let d = s.derive()?;
-    let out = out.claim(d.memory_bytes)?;
     eprintln!(
         "{}: {} × {} cells, τ = {:.4}, Mach {:.3}, Re {:.1}, {} steps -> {}",
         s.name,
@@ -301,7 +378,7 @@ fn run_fluid(path: &Path, out: Out) -> Result<ExitCode> {
         out.display()
     );
     let summary = with_progress(d.steps, "steps", |p| {
-        granflow::scenario::fluid::run::run(&s, out, p)
+        granflow::scenario::fluid::run::run(s, out, control, p)
     })
     .with_context(|| stopped(path, out))?;
     println!(

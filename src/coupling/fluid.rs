@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::ladd::{BounceLinks, LinkCover, LinkForces};
 use super::psm::{weighting, PartialCells};
-use crate::lbm::{Lbm, Real};
+use crate::lbm::{Lbm, LbmState, Real};
 use crate::scale::Scale;
 use crate::{Error, Result};
 
@@ -123,22 +123,12 @@ impl<T: Real> CoupledFluid<T> {
     }
 }
 
-/// A full copy of a fluid state (populations, clock, obstacle loads).
-#[derive(Clone)]
-pub struct LbmSnapshot<T> {
-    populations: Vec<T>,
-    next_even: bool,
-    steps: u64,
-    force: Vec<[f64; 2]>,
-    torque: Vec<f64>,
-}
-
 impl<T: Real> Scale for CoupledFluid<T> {
     /// The cells moving solids cover (an empty cover: a plain fluid).
     type Input = SolidCover;
     /// Force on the solid in each covered cell, averaged over the last advance.
     type Output = CellForces;
-    type Snapshot = LbmSnapshot<T>;
+    type Snapshot = LbmState;
 
     fn time(&self) -> f64 {
         self.lbm.steps as f64 * self.lbm.units.dt
@@ -198,20 +188,12 @@ impl<T: Real> Scale for CoupledFluid<T> {
             .unzip_into_vecs(&mut out.fx, &mut out.fy);
         self.ladd.observe(&self.lbm.units, &mut out.links);
     }
-    fn snapshot(&self) -> LbmSnapshot<T> {
-        let (populations, next_even) = self.lbm.lattice.state();
-        LbmSnapshot {
-            populations,
-            next_even,
-            steps: self.lbm.steps,
-            force: self.lbm.obstacles.force.clone(),
-            torque: self.lbm.obstacles.torque.clone(),
-        }
+    fn snapshot(&self) -> LbmState {
+        self.lbm.state()
     }
-    fn restore(&mut self, s: LbmSnapshot<T>) {
-        self.lbm.lattice.set_state(s.populations, s.next_even);
-        self.lbm.steps = s.steps;
-        self.lbm.obstacles.force = s.force;
-        self.lbm.obstacles.torque = s.torque;
+    fn restore(&mut self, s: LbmState) {
+        self.lbm
+            .set_state(s)
+            .expect("a snapshot of this fluid restores into it");
     }
 }

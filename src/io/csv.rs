@@ -73,6 +73,8 @@ pub struct CsvWriter {
     columns: usize,
     out: BufWriter<File>,
     line: String,
+    /// Bytes in the file so far (header and rows).
+    len: u64,
 }
 
 impl CsvWriter {
@@ -102,6 +104,7 @@ impl CsvWriter {
             columns: header.len(),
             out: BufWriter::new(file),
             line: String::new(),
+            len: 0,
         };
         writer.line = header.join(",");
         writer.line.push('\n');
@@ -133,6 +136,41 @@ impl CsvWriter {
         self.write_line()
     }
 
+    /// Continue the file at `path` of a run that is resumed: its first `len` bytes (its length
+    /// when the run's checkpoint was taken, [`CsvWriter::bytes_written`]) are kept, what a later part of
+    /// the interrupted run appended is cut off, and rows of `columns` values follow. A file
+    /// shorter than `len` is refused.
+    pub fn reopen(path: &Path, columns: usize, len: u64) -> Result<Self> {
+        let file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(path)
+            .map_err(|e| Error::io(path, e))?;
+        let have = file.metadata().map_err(|e| Error::io(path, e))?.len();
+        if have < len {
+            return Err(Error::Other(format!(
+                "{}: {have} bytes, shorter than the {len} the checkpoint recorded",
+                path.display()
+            )));
+        }
+        let mut file = file;
+        file.set_len(len)
+            .and_then(|()| std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0)))
+            .map_err(|e| Error::io(path, e))?;
+        Ok(CsvWriter {
+            path: path.to_path_buf(),
+            columns,
+            out: BufWriter::new(file),
+            line: String::new(),
+            len,
+        })
+    }
+
+    /// Bytes written to the file so far (all flushed).
+    pub fn bytes_written(&self) -> u64 {
+        self.len
+    }
+
     /// Number of columns in the header (and in every row).
     pub fn columns(&self) -> usize {
         self.columns
@@ -147,7 +185,9 @@ impl CsvWriter {
         self.out
             .write_all(self.line.as_bytes())
             .and_then(|()| self.out.flush())
-            .map_err(|e| Error::io(&self.path, e))
+            .map_err(|e| Error::io(&self.path, e))?;
+        self.len += self.line.len() as u64;
+        Ok(())
     }
 }
 

@@ -1,5 +1,6 @@
 //! Output files: VTK (`.vti` images, `.vtu` point/line sets), ParaView collections (`.pvd`),
-//! CSV time series, JSON summaries and SVG figures.
+//! CSV time series, JSON summaries and SVG figures; and the checkpoints a run resumes from
+//! ([`checkpoint`]).
 //!
 //! Every whole-file writer goes through [`write_atomic`]: the data is written to a hidden
 //! temporary file beside the target, synced, and renamed over it, so a run killed mid-write
@@ -7,6 +8,7 @@
 //! instead, so a killed run keeps every complete row.
 
 pub mod atomic;
+pub mod checkpoint;
 pub mod csv;
 pub mod json;
 pub mod plot;

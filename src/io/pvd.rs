@@ -22,7 +22,7 @@ fn xml_escape(s: &str) -> String {
 }
 
 /// One frame of a [`PvdSeries`].
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PvdEntry {
     /// Simulated time of the frame, in seconds.
     pub time: f64,
@@ -67,6 +67,15 @@ impl PvdSeries {
         PvdSeries {
             path: dir.join(Self::FILE_NAME),
             entries: Vec::new(),
+        }
+    }
+
+    /// The series of a resumed run: the frames it had written when its checkpoint was taken
+    /// (nothing is written until the next [`add`](PvdSeries::add)).
+    pub fn resume(dir: &Path, entries: Vec<PvdEntry>) -> Self {
+        PvdSeries {
+            path: dir.join(Self::FILE_NAME),
+            entries,
         }
     }
 

@@ -992,6 +992,11 @@ impl<T: Real> Lattice<T> {
         (self.f.clone(), self.even)
     }
 
+    /// Number of population values [`Lattice::state`] holds (padding included).
+    pub fn state_len(&self) -> usize {
+        self.f.len()
+    }
+
     /// Restore a state from [`Lattice::state`].
     pub fn set_state(&mut self, f: Vec<T>, even: bool) {
         assert_eq!(f.len(), self.f.len(), "snapshot of another lattice");

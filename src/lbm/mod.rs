@@ -25,5 +25,5 @@ pub use collision::{Collider, CollisionModel, MrtRates};
 pub use covered::CoveredCells;
 pub use lattice::Lattice;
 pub use obstacle::{Obstacle, Obstacles, Shape};
-pub use real::Real;
-pub use solver::{Fluid, FluidModel, Lbm, LbmSetup, Macroscopic, STOP_MACH};
+pub use real::{Populations, Real};
+pub use solver::{Fluid, FluidModel, Lbm, LbmSetup, LbmState, Macroscopic, STOP_MACH};

@@ -10,6 +10,19 @@ pub trait Real: Float + Default + Send + Sync + std::fmt::Debug + std::iter::Sum
     fn c(x: f64) -> Self;
     /// Conversion to `f64`.
     fn f64(self) -> f64;
+    /// The populations of a lattice in this precision, tagged for a checkpoint.
+    fn tag(f: Vec<Self>) -> Populations;
+    /// The populations back, if `p` holds this precision.
+    fn untag(p: Populations) -> Option<Vec<Self>>;
+}
+
+/// A lattice's populations in the precision the scenario chose, as a checkpoint stores them.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum Populations {
+    /// Single precision.
+    F32(Vec<f32>),
+    /// Double precision.
+    F64(Vec<f64>),
 }
 
 impl Real for f32 {
@@ -22,6 +35,15 @@ impl Real for f32 {
     fn f64(self) -> f64 {
         self as f64
     }
+    fn tag(f: Vec<Self>) -> Populations {
+        Populations::F32(f)
+    }
+    fn untag(p: Populations) -> Option<Vec<Self>> {
+        match p {
+            Populations::F32(f) => Some(f),
+            Populations::F64(_) => None,
+        }
+    }
 }
 
 impl Real for f64 {
@@ -33,5 +55,14 @@ impl Real for f64 {
     #[inline(always)]
     fn f64(self) -> f64 {
         self
+    }
+    fn tag(f: Vec<Self>) -> Populations {
+        Populations::F64(f)
+    }
+    fn untag(p: Populations) -> Option<Vec<Self>> {
+        match p {
+            Populations::F64(f) => Some(f),
+            Populations::F32(_) => None,
+        }
     }
 }

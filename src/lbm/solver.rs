@@ -10,7 +10,7 @@ use super::covered::CoveredCells;
 use super::d2q9::{CX, CY, Q};
 use super::lattice::Lattice;
 use super::obstacle::{Obstacle, Obstacles};
-use super::real::Real;
+use super::real::{Populations, Real};
 use crate::units::{Units, CS2};
 use crate::{Error, Result};
 
@@ -110,6 +110,22 @@ impl Macroscopic {
     }
 }
 
+/// What of a fluid changes as it runs (populations, parity, clock, obstacle loads): with the
+/// scenario it was built from, all a checkpoint needs to continue the run bit for bit.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct LbmState {
+    /// The populations, padding included ([`Lattice::state`]).
+    pub populations: Populations,
+    /// True when the next step is even (the AA pattern's parity).
+    pub next_even: bool,
+    /// Steps taken.
+    pub steps: u64,
+    /// Force on each obstacle in the last step (lattice units).
+    pub force: Vec<[f64; 2]>,
+    /// Torque on each obstacle in the last step (lattice units).
+    pub torque: Vec<f64>,
+}
+
 /// A D2Q9 fluid in precision `T`.
 pub struct Lbm<T> {
     /// Populations, walls and edges.
@@ -148,6 +164,47 @@ impl<T: Real> Lbm<T> {
             units,
             steps: 0,
         }
+    }
+
+    /// A copy of the state that changes as the fluid runs.
+    pub fn state(&self) -> LbmState {
+        let (f, next_even) = self.lattice.state();
+        LbmState {
+            populations: T::tag(f),
+            next_even,
+            steps: self.steps,
+            force: self.obstacles.force.clone(),
+            torque: self.obstacles.torque.clone(),
+        }
+    }
+
+    /// Continue from a state taken by [`Lbm::state`] of a fluid built the same way; a state of
+    /// another precision, lattice size or obstacle count is refused.
+    pub fn set_state(&mut self, s: LbmState) -> Result<()> {
+        let precision = match &s.populations {
+            Populations::F32(_) => "f32",
+            Populations::F64(_) => "f64",
+        };
+        let f = T::untag(s.populations).ok_or_else(|| {
+            Error::Other(format!(
+                "the saved fluid has {precision} populations, this one {}",
+                T::NAME
+            ))
+        })?;
+        if f.len() != self.lattice.state_len() || s.force.len() != self.obstacles.force.len() {
+            return Err(Error::Other(format!(
+                "the saved fluid has {} population values and {} obstacles, this one {} and {}",
+                f.len(),
+                s.force.len(),
+                self.lattice.state_len(),
+                self.obstacles.force.len()
+            )));
+        }
+        self.lattice.set_state(f, s.next_even);
+        self.steps = s.steps;
+        self.obstacles.force = s.force;
+        self.obstacles.torque = s.torque;
+        Ok(())
     }
 
     /// One lattice step.
@@ -283,6 +340,10 @@ pub trait Fluid: Send {
     fn bytes(&self) -> usize;
     /// `"f32"` or `"f64"`.
     fn precision(&self) -> &'static str;
+    /// A copy of the state that changes as the fluid runs ([`Lbm::state`]).
+    fn state(&self) -> LbmState;
+    /// Continue from a saved state ([`Lbm::set_state`]).
+    fn set_state(&mut self, s: LbmState) -> Result<()>;
 }
 
 impl<T: Real> Fluid for Lbm<T> {
@@ -326,5 +387,11 @@ impl<T: Real> Fluid for Lbm<T> {
     }
     fn precision(&self) -> &'static str {
         T::NAME
+    }
+    fn state(&self) -> LbmState {
+        Lbm::state(self)
+    }
+    fn set_state(&mut self, s: LbmState) -> Result<()> {
+        Lbm::set_state(self, s)
     }
 }

@@ -13,11 +13,13 @@
 //! * [`mpm`]: the GIMPM column collapse;
 //! * [`submerged`]: the LBM–DEM submerged collapse;
 //! * [`collapse`]: the one column-collapse runner, for the DEM, MPM and submerged solids;
-//! * [`validation`]: the registry of validation cases (`granflow validate`).
+//! * [`validation`]: the registry of validation cases (`granflow validate`);
+//! * [`checkpointing`]: checkpoints, resume and the stop signals ask for.
 //!
 //! Studies over many scenarios are in [`crate::sweep`]. Nothing in the physics storey
 //! (`lbm`, `dem`, `mpm`, `coupling`) imports this module.
 
+pub mod checkpointing;
 pub mod collapse;
 pub mod dem;
 pub mod fluid;

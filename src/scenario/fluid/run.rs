@@ -9,6 +9,10 @@
 //!
 //! Every frame is written to a temporary name and renamed; a run that goes unstable (NaN,
 //! ρ ≤ 0, Mach > 0.5) stops with [`Error::Unstable`], keeping the frames already written.
+//! With `--checkpoint-every` the run saves its state (`checkpoint_<step>.ckpt`, the newest two
+//! kept, removed when the run completes); asked to stop, it saves one and writes the current
+//! frame; resumed, it cuts the time series back to the checkpoint and continues
+//! ([`crate::scenario::checkpointing`]).
 
 use std::path::Path;
 use std::time::Instant;
@@ -16,9 +20,11 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::analysis::spectrum::dominant_frequency;
-use crate::io::{write_json, write_vti, CsvWriter, Field, ImageGrid, PvdSeries};
-use crate::lbm::{Fluid, Macroscopic, STOP_MACH};
+use crate::io::{write_json, write_vti, CsvWriter, Field, ImageGrid, PvdEntry, PvdSeries};
+use crate::lbm::{Fluid, LbmState, Macroscopic, STOP_MACH};
+use crate::scenario::checkpointing::Control;
 use crate::scenario::fluid::{Derived, Scenario};
+use crate::scenario::Kind;
 use crate::Result;
 
 /// Most steps between two stability checks.
@@ -65,31 +71,62 @@ pub struct Summary {
     pub mlups: f64,
 }
 
-/// Run `scenario`, writing into `out` (created if needed). Returns the summary, which is
-/// also written, or the error that stopped the run (after writing the summary with it).
-pub fn run(scenario: &Scenario, out: &Path, progress: crate::exec::Progress) -> Result<Summary> {
+/// What a fluid run saves in a checkpoint: the fluid's state and the bookkeeping of its
+/// outputs, enough to continue it bit for bit.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Saved {
+    lbm: LbmState,
+    frames: usize,
+    series_bytes: u64,
+    pvd: Vec<PvdEntry>,
+    lift: Vec<f64>,
+    mass0: f64,
+    wall_seconds: f64,
+}
+
+/// Run `scenario`, writing into `out` (created if needed), checkpointing, stopping and
+/// resuming as `control` says. Returns the summary, which is also written, or the error
+/// that stopped the run (after writing the summary with it).
+pub fn run(
+    scenario: &Scenario,
+    out: &Path,
+    mut control: Control,
+    progress: crate::exec::Progress,
+) -> Result<Summary> {
     let (mut fluid, derived) = scenario.build()?;
     crate::io::run_dir::create(out)?;
-    let mut state = Outputs::create(scenario, &derived, out)?;
     let names: Vec<String> = scenario
         .lattice_obstacles(&derived.units)
         .into_iter()
         .map(|o| o.name)
         .collect();
-    let mass0 = fluid.total_mass();
+    let mut macro_ = Macroscopic::default();
+    let (mut state, mut lift, mass0, wall0) = match control.load::<Saved>(out, Kind::Fluid)? {
+        Some(saved) => {
+            let saved = saved.state;
+            let state = Outputs::resume(scenario, &derived, out, &saved)?;
+            fluid.set_state(saved.lbm)?;
+            (state, saved.lift, saved.mass0, saved.wall_seconds)
+        }
+        None => {
+            let mut state = Outputs::create(scenario, &derived, out)?;
+            state.row(fluid.as_ref(), &mut macro_)?;
+            state.write_frame(&macro_, 0.0)?;
+            (state, Vec::new(), fluid.total_mass(), 0.0)
+        }
+    };
     let start = Instant::now();
     let total = derived.steps;
+    let dt = derived.units.dt;
+    let checkpoint_every = control.every_steps(dt).unwrap_or(total);
     let mut result = Ok(());
-    let mut macro_ = Macroscopic::default();
-    state.row(fluid.as_ref(), &mut macro_)?;
-    state.write_frame(&macro_, 0.0)?;
-    let mut lift = Vec::new();
     while fluid.step_count() < total {
         let s = fluid.step_count();
         let next = [
             next_multiple(s, derived.series_every),
             next_multiple(s, derived.frame_every),
             next_multiple(s, CHECK_EVERY),
+            next_multiple(s, checkpoint_every),
             total,
         ]
         .into_iter()
@@ -108,16 +145,40 @@ pub fn run(scenario: &Scenario, out: &Path, progress: crate::exec::Progress) -> 
                 lift.push(fluid.obstacle_loads().0.first().map_or(0.0, |f| f[1]));
             }
         }
-        if s % derived.frame_every == 0 || s == total {
+        let frame = s % derived.frame_every == 0 || s == total;
+        if frame {
             // A row just filled the fields; otherwise compute them for the frame.
             if !row {
                 fluid.macroscopic(&mut macro_);
             }
-            state.write_frame(&macro_, s as f64 * derived.units.dt)?;
+            state.write_frame(&macro_, s as f64 * dt)?;
+        }
+        let signal = control.stop_signal().filter(|_| s < total);
+        if (control.due(s, dt) && s < total) || signal.is_some() {
+            let saved = Saved {
+                lbm: fluid.state(),
+                frames: state.frames,
+                series_bytes: state.series.bytes_written(),
+                pvd: state.pvd.entries().to_vec(),
+                lift: lift.clone(),
+                mass0,
+                wall_seconds: wall0 + start.elapsed().as_secs_f64(),
+            };
+            let path = control.save(out, Kind::Fluid, s, s as f64 * dt, &saved)?;
+            if let Some(signal) = signal {
+                // The fields as they are now, for a look; the resumed run writes its own
+                // frame of this number when one is due.
+                if !frame {
+                    fluid.macroscopic(&mut macro_);
+                    state.write_frame(&macro_, s as f64 * dt)?;
+                }
+                result = Err(control.interrupted(signal, s, s as f64 * dt, path, out));
+                break;
+            }
         }
         progress(s, total);
     }
-    let wall = start.elapsed().as_secs_f64();
+    let wall = wall0 + start.elapsed().as_secs_f64();
     let cells = (derived.cells[0] * derived.cells[1]) as f64;
     let (forces, torques) = fluid.obstacle_loads();
     let u = &derived.units;
@@ -161,6 +222,9 @@ pub fn run(scenario: &Scenario, out: &Path, progress: crate::exec::Progress) -> 
         mlups: cells * fluid.step_count() as f64 / wall / 1e6,
     };
     write_json(&out.join("summary.json"), &summary)?;
+    if result.is_ok() {
+        crate::io::checkpoint::remove_all(out)?;
+    }
     result.map(|()| summary)
 }
 
@@ -192,6 +256,60 @@ struct Outputs {
 
 impl Outputs {
     fn create(scenario: &Scenario, derived: &Derived, dir: &Path) -> Result<Self> {
+        let header = Self::header(scenario);
+        let header: Vec<&str> = header.iter().map(String::as_str).collect();
+        let series = CsvWriter::create(&dir.join("timeseries.csv"), &header)?;
+        Ok(Self::with(
+            scenario,
+            derived,
+            dir,
+            series,
+            PvdSeries::new(dir),
+            0,
+        ))
+    }
+
+    /// The outputs of a run resumed from `saved`: the time series cut back to its length then
+    /// and appended to, the frames it had.
+    fn resume(scenario: &Scenario, derived: &Derived, dir: &Path, saved: &Saved) -> Result<Self> {
+        let columns = Self::header(scenario).len();
+        let series = CsvWriter::reopen(&dir.join("timeseries.csv"), columns, saved.series_bytes)?;
+        let pvd = PvdSeries::resume(dir, saved.pvd.clone());
+        Ok(Self::with(
+            scenario,
+            derived,
+            dir,
+            series,
+            pvd,
+            saved.frames,
+        ))
+    }
+
+    fn with(
+        scenario: &Scenario,
+        derived: &Derived,
+        dir: &Path,
+        series: CsvWriter,
+        pvd: PvdSeries,
+        frames: usize,
+    ) -> Self {
+        Outputs {
+            dir: dir.to_path_buf(),
+            derived: derived.clone(),
+            rho0: scenario.fluid.density,
+            series,
+            pvd,
+            probes: scenario
+                .probes
+                .iter()
+                .map(|p| scenario.cell_at(derived, p.position))
+                .collect(),
+            frames,
+        }
+    }
+
+    /// The time series' column names.
+    fn header(scenario: &Scenario) -> Vec<String> {
         let mut header: Vec<String> = ["t", "step", "mass", "kinetic_energy", "max_speed"]
             .iter()
             .map(|s| s.to_string())
@@ -215,20 +333,7 @@ impl Outputs {
                 format!("{}_uy", p.name),
             ]);
         }
-        let header: Vec<&str> = header.iter().map(String::as_str).collect();
-        Ok(Outputs {
-            dir: dir.to_path_buf(),
-            derived: derived.clone(),
-            rho0: scenario.fluid.density,
-            series: CsvWriter::create(&dir.join("timeseries.csv"), &header)?,
-            pvd: PvdSeries::new(dir),
-            probes: scenario
-                .probes
-                .iter()
-                .map(|p| scenario.cell_at(derived, p.position))
-                .collect(),
-            frames: 0,
-        })
+        header
     }
 
     /// Append a time-series row; leaves the macroscopic fields in `m`.

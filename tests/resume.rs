@@ -1,0 +1,231 @@
+//! Runs that survive: a run killed with SIGKILL part-way and resumed from its checkpoint, and
+//! one stopped by SIGTERM and resumed, end with the same files, byte for byte, as a run that
+//! was never interrupted; bad resumes are refused with the reason.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn granflow() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_granflow"))
+}
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+/// The fluid scenario of these tests: ≈ 51 000 steps of 128² cells, a few seconds.
+fn cavity() -> PathBuf {
+    data("resume_cavity.toml")
+}
+
+fn run(args: &[&str], out: &Path) -> std::process::Output {
+    granflow()
+        .arg("run")
+        .arg(cavity())
+        .arg("--out")
+        .arg(out)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn resume(out: &Path) -> std::process::Output {
+    granflow().arg("resume").arg(out).output().unwrap()
+}
+
+fn spawn(args: &[&str], out: &Path) -> Child {
+    granflow()
+        .arg("run")
+        .arg(cavity())
+        .arg("--out")
+        .arg(out)
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Wait (at most a minute) until `file` exists in `dir` (`None`: any checkpoint).
+fn wait_for(dir: &Path, file: Option<&str>) {
+    let start = Instant::now();
+    loop {
+        let found = std::fs::read_dir(dir).ok().is_some_and(|entries| {
+            entries.flatten().any(|e| {
+                let name = e.file_name().to_string_lossy().into_owned();
+                match file {
+                    Some(f) => name == f,
+                    None => name.starts_with("checkpoint_") && name.ends_with(".ckpt"),
+                }
+            })
+        });
+        if found {
+            return;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no {file:?} in {}",
+            dir.display()
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+fn ok(out: &std::process::Output) {
+    assert!(
+        out.status.success(),
+        "{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The files of a finished run, by name (summary.json without its wall-clock entries).
+fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut all: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            let name = e.file_name().to_string_lossy().into_owned();
+            let mut bytes = std::fs::read(e.path()).unwrap();
+            if name == "summary.json" {
+                let mut v: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+                let o = v.as_object_mut().unwrap();
+                o.remove("wall_seconds");
+                o.remove("mlups");
+                bytes = v.to_string().into_bytes();
+            }
+            (name, bytes)
+        })
+        .collect();
+    all.sort();
+    all
+}
+
+/// The same file names and contents in both folders.
+fn same_run(reference: &Path, resumed: &Path) {
+    let (a, b) = (files(reference), files(resumed));
+    let names = |f: &[(String, Vec<u8>)]| f.iter().map(|x| x.0.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&a), names(&b));
+    for ((name, x), (_, y)) in a.iter().zip(&b) {
+        assert!(
+            x == y,
+            "{name} differs between the uninterrupted and the resumed run"
+        );
+    }
+    assert!(a.iter().filter(|f| f.0.ends_with(".vti")).count() >= 7);
+}
+
+/// One uninterrupted run, shared by the tests that compare against it.
+fn reference() -> &'static Path {
+    static DIR: std::sync::OnceLock<tempfile::TempDir> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        ok(&run(&[], dir.path()));
+        dir
+    })
+    .path()
+}
+
+#[test]
+fn a_run_killed_part_way_resumes_to_the_uninterrupted_result() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut child = spawn(&["--checkpoint-every", "2.0"], dir.path());
+    wait_for(dir.path(), None);
+    child.kill().unwrap(); // SIGKILL
+    let status = child.wait().unwrap();
+    assert!(
+        !status.success(),
+        "the run finished before it was killed; the test needs a longer scenario"
+    );
+    let out = resume(dir.path());
+    ok(&out);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("resuming from"));
+    same_run(reference(), dir.path());
+    // The checkpoints went with the completed run, and a second resume has nothing to do.
+    let out = resume(dir.path());
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("completed"));
+}
+
+#[test]
+fn sigterm_saves_a_checkpoint_exits_143_and_resumes_to_the_uninterrupted_result() {
+    let dir = tempfile::tempdir().unwrap();
+    // No --checkpoint-every: the signal alone writes the checkpoint.
+    let child = spawn(&[], dir.path());
+    wait_for(dir.path(), Some("fluid_000001.vti"));
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(143), "{stderr}");
+    assert!(
+        stderr.contains("stopped by SIGTERM") && stderr.contains("granflow resume"),
+        "{stderr}"
+    );
+    let summary = std::fs::read_to_string(dir.path().join("summary.json")).unwrap();
+    assert!(summary.contains("stopped by SIGTERM"), "{summary}");
+    ok(&resume(dir.path()));
+    same_run(reference(), dir.path());
+}
+
+#[test]
+fn a_resume_of_a_changed_scenario_or_a_folder_without_a_run_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let child = spawn(&["--checkpoint-every", "2.0"], dir.path());
+    wait_for(dir.path(), None);
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(130));
+    let copy = dir.path().join("scenario.toml");
+    let text = std::fs::read_to_string(&copy).unwrap();
+    std::fs::write(&copy, text.replace("viscosity = 0.01", "viscosity = 0.02")).unwrap();
+    let out = resume(dir.path());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("another scenario text"),
+        "{stderr}"
+    );
+
+    let empty = tempfile::tempdir().unwrap();
+    let out = resume(empty.path());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("holds no run"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn checkpoints_are_refused_where_a_kind_cannot_write_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let dem = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/column_collapse/dem_a2.toml");
+    let out = granflow()
+        .arg("run")
+        .arg(dem)
+        .arg("--out")
+        .arg(dir.path())
+        .args(["--checkpoint-every", "0.1"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("--checkpoint-every"),
+        "{stderr}"
+    );
+    let out = run(&["--checkpoint-every", "-1"], dir.path());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("positive"),
+        "{stderr}"
+    );
+}

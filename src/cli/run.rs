@@ -221,10 +221,8 @@ fn run_mpm(path: &Path, out: Out, volumes: &[[f64; 2]]) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn run_dem(path: &Path, out: Out) -> Result<ExitCode> {
-    let s = DemScenario::from_file(path)?;
+fn run_dem(s: &DemScenario, path: &Path, out: &Path, control: Control) -> Result<ExitCode> {
     let d = s.derive()?;
-    let out = out.claim(dem_memory(d.grains))?;
     eprintln!(
         "{}: DEM column collapse, {} grains -> {}",
         s.name,
@@ -233,7 +231,7 @@ fn run_dem(path: &Path, out: Out) -> Result<ExitCode> {
     );
     let end = (1e3 * s.time.end_tc) as u64;
     let r = with_progress(end, "milli-τ_c", |p| {
-        granflow::scenario::collapse::dem::run_column_collapse(&s, out, p)
+        granflow::scenario::collapse::dem::run_resumable_collapse(s, out, control, p)
     })
     .with_context(|| stopped(path, out))?;
     println!(
@@ -275,16 +273,24 @@ pub fn run(
             RESUMABLE.map(|k| format!("`{k}`")).join(", ")
         );
     }
+    let start = |memory: usize| -> Result<(&Path, Control)> {
+        let text = read_text(path)?;
+        let control = Control::new(&text, checkpoint_every, super::stop_on_signals()?)?;
+        let dir = out.claim(memory)?;
+        keep_scenario(dir, &text)?;
+        Ok((dir, control))
+    };
     match kind {
         Kind::Fluid => {
-            let text = read_text(path)?;
-            let control = Control::new(&text, checkpoint_every, super::stop_on_signals()?)?;
             let s = Scenario::from_file(path)?;
-            let dir = out.claim(s.derive()?.memory_bytes)?;
-            keep_scenario(dir, &text)?;
+            let (dir, control) = start(s.derive()?.memory_bytes)?;
             run_fluid(&s, path, dir, control)
         }
-        Kind::Dem => run_dem(path, out),
+        Kind::Dem => {
+            let s = DemScenario::from_file(path)?;
+            let (dir, control) = start(dem_memory(s.derive()?.grains))?;
+            run_dem(&s, path, dir, control)
+        }
         Kind::Mpm => run_mpm(path, out, volumes),
         Kind::Submerged => run_submerged(path, out),
         Kind::Sweep => anyhow::bail!(
@@ -308,7 +314,7 @@ fn run_submerged(path: &Path, out: Out) -> Result<ExitCode> {
 }
 
 /// The kinds whose runs write checkpoints and stop cleanly on SIGINT/SIGTERM.
-const RESUMABLE: [Kind; 1] = [Kind::Fluid];
+const RESUMABLE: [Kind; 2] = [Kind::Fluid, Kind::Dem];
 
 fn read_text(path: &Path) -> Result<String> {
     std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
@@ -347,6 +353,11 @@ pub fn resume(dir: &Path) -> Result<ExitCode> {
             let s = Scenario::from_file(&path)?;
             granflow::exec::check_memory(s.derive()?.memory_bytes as u64)?;
             run_fluid(&s, &path, dir, control)
+        }
+        Kind::Dem => {
+            let s = DemScenario::from_file(&path)?;
+            granflow::exec::check_memory(dem_memory(s.derive()?.grains) as u64)?;
+            run_dem(&s, &path, dir, control)
         }
         other => anyhow::bail!(
             "cannot resume {}: it holds a `{other}` run, and only {} runs write checkpoints so far",

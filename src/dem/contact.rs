@@ -69,7 +69,7 @@
 //! mismatch at onset and end steps).
 
 /// Parameters of one contact type (grain–grain or grain–wall), SI.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContactParams {
     /// Normal stiffness k_n (N/m, or N/m per unit depth in plane 2-D).
     pub k_n: f64,
@@ -161,7 +161,7 @@ pub fn critical_step(k: f64, m: f64, xi: f64) -> f64 {
 }
 
 /// A contact law with the constants of [`ContactParams`] precomputed for the force loop.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Law {
     /// k_n.
     pub k_n: f64,
@@ -200,7 +200,7 @@ impl From<&ContactParams> for Law {
 }
 
 /// What a contact carries from one step to the next (stored per pair in the neighbour list).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContactState {
     /// Overlap δ at the last evaluation if the grains touched then (> 0); ≤ 0 or NaN: apart.
     pub delta: f64,
@@ -253,7 +253,7 @@ impl ContactState {
 /// A contact that began or ended inside the step: the difference **F**_{k+1} − **F**^end of
 /// its force on grain `i` ([F_x, F_y, torque on i, torque on j]; −F on `j`), added to the
 /// force arrays after the second half-kick so the next step starts from the true force.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Event {
     /// Grain i.
     pub i: u32,

@@ -44,7 +44,7 @@ use super::neighbours::{Detector, PairList, WallList};
 use super::walls::Wall;
 
 /// Which pairs the rapier detector reports.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Coverage {
     /// Every grain–grain and grain–wall pair.
     All,
@@ -57,7 +57,7 @@ pub enum Coverage {
 pub const WALL_BIT: u32 = 1 << 31;
 
 /// One contact point.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Contact {
     /// First grain.
     pub i: u32,
@@ -124,6 +124,21 @@ impl Clone for RapierDetector {
     /// (rapier's caches are not part of the state: contact history lives with the caller).
     fn clone(&self) -> Self {
         RapierDetector::new(self.coverage, self.prediction)
+    }
+}
+
+/// A checkpoint keeps what the detector is (coverage, prediction), not rapier's caches: like a
+/// clone, a detector read back builds its colliders at its first detection.
+impl serde::Serialize for RapierDetector {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        (self.coverage, self.prediction).serialize(s)
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for RapierDetector {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let (coverage, prediction) = <(Coverage, f64)>::deserialize(d)?;
+        Ok(RapierDetector::new(coverage, prediction))
     }
 }
 

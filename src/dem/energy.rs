@@ -17,7 +17,7 @@ use serde::Serialize;
 use crate::analysis::runout::EnergyBudget;
 
 /// Energies of a DEM system at one instant (state terms) and since the start (cumulative terms).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct Energy {
     /// Translational kinetic energy Σ ½ m |v|².
     pub kinetic: f64,

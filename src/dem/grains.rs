@@ -7,7 +7,7 @@
 use super::shape::{Polygons, DISK};
 
 /// Grains (disks or convex polygons), structure of arrays.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Grains {
     /// Centre x (m).
     pub x: Vec<f64>,

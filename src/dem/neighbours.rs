@@ -21,7 +21,7 @@ use super::walls::Wall;
 const CHUNK: usize = 512;
 
 /// Grain–grain pairs within reach, with their contact history and last forces.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct PairList {
     /// First grain of each pair (i < j); sorted by (i, j).
     pub i: Vec<u32>,
@@ -41,7 +41,7 @@ pub struct PairList {
 pub const PAIR_TOUCHING: u8 = 1;
 
 /// Grain–wall pairs within reach, sorted by (grain, wall).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct WallList {
     /// Grain of each pair.
     pub grain: Vec<u32>,
@@ -54,7 +54,7 @@ pub struct WallList {
 }
 
 /// Cell list and reusable scratch for building the neighbour lists.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Detector {
     /// Verlet skin (m).
     pub skin: f64,

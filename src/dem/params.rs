@@ -4,7 +4,7 @@
 use super::contact::ContactParams;
 
 /// Parameters of a DEM system, SI.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct DemParams {
     /// Grain–grain contact law.
     pub grain: ContactParams,

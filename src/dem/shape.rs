@@ -20,7 +20,7 @@
 pub const DISK: u32 = u32::MAX;
 
 /// Mass properties of a polygon per unit areal density.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PolygonProps {
     /// Area A.
     pub area: f64,
@@ -55,7 +55,7 @@ pub fn polygon_props(v: &[[f64; 2]]) -> PolygonProps {
 }
 
 /// The shared table of polygon shapes (structure of arrays).
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Polygons {
     /// Vertices of all polygons, body frame (centroid at the origin), counter-clockwise.
     pub verts: Vec<[f64; 2]>,

@@ -54,7 +54,7 @@ pub struct ShapeSums {
 }
 
 /// Contact points of the rapier-detected pairs with their history.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct ShapeContacts {
     det: RapierDetector,
     /// Contacts of the last evaluation, sorted by (i, j, key).

@@ -9,7 +9,7 @@
 //! δ = R − s. The wall acts as a grain of infinite mass at rest (m_eff = m_i, R_eff = R_i).
 
 /// A fixed wall.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Wall {
     /// The half-plane behind the line through `point` with unit `normal` pointing into the
     /// domain: s = (**c** − **p**)·**N**, **n** = −**N**. Never tunnelled: a grain found behind

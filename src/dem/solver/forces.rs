@@ -452,7 +452,7 @@ impl<'a> Drift<'a> {
 }
 
 /// A force queued by one chunk's force pass for a grain of a later chunk.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct JForce {
     /// The grain (second grain of the pair).
     j: u32,

@@ -67,7 +67,7 @@ pub struct ExternalLoads {
 }
 
 /// Per-chunk sums of one force evaluation.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 struct Part {
     e_n: f64,
     e_t: f64,
@@ -87,7 +87,7 @@ struct Part {
 }
 
 /// An overlap δ relative to the smaller radius of the pair, and the pair.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Overlap {
     /// δ/min(R_i, R_j) (δ/R_i for a wall).
     pub relative: f64,
@@ -152,7 +152,7 @@ impl Part {
 }
 
 /// A DEM system: grains, walls, contact laws, neighbour lists, clock and energy budget.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Dem {
     /// The grains.
     pub grains: Grains,

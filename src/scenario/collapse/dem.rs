@@ -31,14 +31,16 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::{run_column, steps_per_row, Column, Plan, Row, Tally};
+use super::{run_column, run_resumable, steps_per_row, Column, Plan, Row, Tally};
 use crate::analysis::runout::CollapseOutcome;
 use crate::dem::packing::deposit_column;
 use crate::dem::stress::grain_stress;
 use crate::dem::{Dem, Energy, Wall};
 use crate::exec::Progress;
 use crate::io::{write_vtu_points, Field, PvdSeries};
+use crate::scenario::checkpointing::Control;
 use crate::scenario::dem::spec::{DemScenario, DemTimeSpec};
+use crate::scenario::Kind;
 use crate::Result;
 
 /// Two grains belong to the same mass when their gap is below this fraction of R_i + R_j.
@@ -240,6 +242,7 @@ pub fn write_frame(
 }
 
 /// A DEM column: the grains after deposition, released between the floor and the side walls.
+#[derive(Serialize, serde::Deserialize)]
 pub struct DemColumn {
     /// The grains and walls.
     pub dem: Dem,
@@ -419,4 +422,25 @@ pub fn run_column_collapse(
 ) -> Result<CollapseSummary> {
     let (column, plan) = column(scenario)?;
     run_column(column, &plan, out_dir, progress)
+}
+
+/// [`run_column_collapse`] with checkpoints, a stop on request and resume ([`Control`]): a
+/// resumed run takes its deposited, released column from the checkpoint.
+pub fn run_resumable_collapse(
+    scenario: &DemScenario,
+    out_dir: &Path,
+    control: Control,
+    progress: Progress,
+) -> Result<CollapseSummary> {
+    let plan_of = |h_i, potential| {
+        plan(
+            &scenario.name,
+            [scenario.column.width, h_i],
+            scenario.gravity,
+            potential,
+            &scenario.time,
+        )
+    };
+    let start = || column(scenario);
+    run_resumable(Kind::Dem, start, plan_of, out_dir, control, progress)
 }

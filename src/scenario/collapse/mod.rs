@@ -19,14 +19,17 @@ pub mod dem;
 pub mod mpm;
 pub mod submerged;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use serde::Serialize;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
 
 use crate::analysis::runout::{CollapseOutcome, CollapseRecord, EnergyBudget};
 use crate::exec::Progress;
-use crate::io::{write_json, CsvWriter, PvdSeries};
+use crate::io::{write_json, CsvWriter, PvdEntry, PvdSeries};
+use crate::scenario::checkpointing::Control;
+use crate::scenario::Kind;
 use crate::Result;
 
 /// One time-series row of a collapsing column.
@@ -124,9 +127,104 @@ impl Plan<'_> {
 /// Run `column` to rest by `plan`, writing into `out_dir` (created if missing); returns the
 /// summary also written to `summary.json`. `progress` is told the time in thousandths of τ_c.
 pub fn run_column<C: Column>(
+    column: C,
+    plan: &Plan,
+    out_dir: &Path,
+    progress: Progress,
+) -> Result<C::Summary> {
+    let never = Control::default();
+    let hooks = Hooks {
+        control: &never,
+        save: None,
+        resumed: None,
+    };
+    run_loop(column, plan, out_dir, hooks, progress)
+}
+
+/// What the runner itself has done by a time-series row, saved with the column in a
+/// checkpoint: rows and frames written, the rest test's clock, the run-out history, the
+/// length of the time series and the frames listed, and the wall time spent.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct Bookkeeping {
+    row: u64,
+    frame: usize,
+    rest_since: Option<f64>,
+    history: Vec<(f64, f64)>,
+    series_bytes: u64,
+    pvd: Vec<PvdEntry>,
+    wall_time_s: f64,
+}
+
+/// A collapse checkpoint: the column (its solver state and own bookkeeping), what its plan
+/// was derived from (deposited height, potential energy), and the runner's [`Bookkeeping`].
+#[derive(Serialize, Deserialize)]
+pub struct Saved<C> {
+    /// The column.
+    pub column: C,
+    /// Initial height H_i (m).
+    pub h_i: f64,
+    /// Initial potential energy above the floor (J).
+    pub potential: f64,
+    run: Bookkeeping,
+}
+
+/// Run a `kind` collapse that checkpoints, stops and resumes as `control` says: the column
+/// comes from the newest checkpoint in `out_dir` when the run resumes, otherwise from
+/// `start` (deposition and release); `plan_of` derives the plan from H_i and the potential
+/// energy.
+pub fn run_resumable<'p, C>(
+    kind: Kind,
+    start: impl FnOnce() -> Result<(C, Plan<'p>)>,
+    plan_of: impl FnOnce(f64, f64) -> Plan<'p>,
+    out_dir: &Path,
+    mut control: Control,
+    progress: Progress,
+) -> Result<C::Summary>
+where
+    C: Column + Serialize + DeserializeOwned,
+{
+    crate::io::run_dir::create(out_dir)?;
+    let (column, plan, resumed) = match control.load::<Saved<C>>(out_dir, kind)? {
+        Some(l) => {
+            let s = l.state;
+            (s.column, plan_of(s.h_i, s.potential), Some(s.run))
+        }
+        None => {
+            let (column, plan) = start()?;
+            (column, plan, None)
+        }
+    };
+    let save = |c: &C, run: &Bookkeeping| {
+        let saved = Saved {
+            column: c,
+            h_i: plan.h_i,
+            potential: plan.potential,
+            run: run.clone(),
+        };
+        control.save(out_dir, kind, run.row, c.time(), &saved)
+    };
+    let hooks = Hooks {
+        control: &control,
+        save: Some(&save),
+        resumed,
+    };
+    let summary = run_loop(column, &plan, out_dir, hooks, progress)?;
+    crate::io::checkpoint::remove_all(out_dir)?;
+    Ok(summary)
+}
+
+/// How [`run_loop`] checkpoints: when and how to save, and where it resumes from.
+struct Hooks<'h, C> {
+    control: &'h Control,
+    save: Option<&'h dyn Fn(&C, &Bookkeeping) -> Result<PathBuf>>,
+    resumed: Option<Bookkeeping>,
+}
+
+fn run_loop<C: Column>(
     mut column: C,
     plan: &Plan,
     out_dir: &Path,
+    hooks: Hooks<C>,
     progress: Progress,
 ) -> Result<C::Summary> {
     crate::io::run_dir::create(out_dir)?;
@@ -134,35 +232,45 @@ pub fn run_column<C: Column>(
     let frame_every = ((plan.frame_interval_tc / plan.series_interval_tc).round() as u64).max(1);
     let mut header = vec!["t", "t_over_tc", "runout", "front", "height"];
     header.extend_from_slice(column.columns());
-    let mut csv = CsvWriter::create(&out_dir.join("timeseries.csv"), &header)?;
-    let mut pvd = PvdSeries::new(out_dir);
+    let series = out_dir.join("timeseries.csv");
+    let (mut csv, mut pvd, mut b) = match hooks.resumed {
+        Some(b) => (
+            CsvWriter::reopen(&series, header.len(), b.series_bytes)?,
+            PvdSeries::resume(out_dir, b.pvd.clone()),
+            b,
+        ),
+        None => (
+            CsvWriter::create(&series, &header)?,
+            PvdSeries::new(out_dir),
+            Bookkeeping::default(),
+        ),
+    };
     let rest_limit = plan.rest_kinetic_fraction * plan.potential;
-    let (mut rest_since, mut at_rest) = (None::<f64>, false);
-    let (mut row, mut frame) = (0u64, 0usize);
-    let mut history = Vec::new();
+    let mut at_rest = false;
     let t_run = Instant::now();
+    let row_seconds = plan.series_interval_tc * tau_c;
     let mut values = Vec::with_capacity(header.len());
     let (mut last, mut height);
     loop {
         let t = column.time();
         let (r, shape) = column.measure()?;
-        history.push((t, r.runout));
+        b.history.push((t, r.runout));
         values.clear();
         values.extend([t, t / tau_c, r.runout, r.front, r.height]);
         values.extend_from_slice(&r.values);
         csv.row(&values)?;
-        if row % frame_every == 0 {
-            column.write_frame(&shape, out_dir, frame, t, &mut pvd)?;
-            frame += 1;
+        if b.row % frame_every == 0 {
+            column.write_frame(&shape, out_dir, b.frame, t, &mut pvd)?;
+            b.frame += 1;
         }
-        row += 1;
+        b.row += 1;
         if r.kinetic < rest_limit {
-            let since = *rest_since.get_or_insert(t);
+            let since = *b.rest_since.get_or_insert(t);
             if t >= tau_c && t - since >= plan.rest_duration_tc * tau_c {
                 at_rest = true;
             }
         } else {
-            rest_since = None;
+            b.rest_since = None;
         }
         (last, height) = (shape, r.height);
         progress((1e3 * t / tau_c) as u64, (1e3 * plan.end_tc) as u64);
@@ -170,11 +278,29 @@ pub fn run_column<C: Column>(
             break;
         }
         column.advance()?;
+        let Some(save) = hooks.save else { continue };
+        let signal = hooks.control.stop_signal();
+        if hooks.control.due(b.row, row_seconds) || signal.is_some() {
+            b.series_bytes = csv.bytes_written();
+            b.pvd = pvd.entries().to_vec();
+            let wall = b.wall_time_s;
+            b.wall_time_s += t_run.elapsed().as_secs_f64();
+            let path = save(&column, &b)?;
+            b.wall_time_s = wall;
+            if let Some(signal) = signal {
+                // The state now, for a look; the resumed run writes its own frame of this
+                // number when one is due.
+                let (_, shape) = column.measure()?;
+                let t = column.time();
+                column.write_frame(&shape, out_dir, b.frame, t, &mut pvd)?;
+                return Err(hooks.control.interrupted(signal, b.row, t, path, out_dir));
+            }
+        }
     }
-    let wall_time_s = t_run.elapsed().as_secs_f64();
+    let wall_time_s = b.wall_time_s + t_run.elapsed().as_secs_f64();
     let t_end = column.time();
-    if (row - 1) % frame_every != 0 {
-        column.write_frame(&last, out_dir, frame, t_end, &mut pvd)?;
+    if (b.row - 1) % frame_every != 0 {
+        column.write_frame(&last, out_dir, b.frame, t_end, &mut pvd)?;
     }
     let tally = column.tally(&last);
     let collapse = CollapseOutcome::from(CollapseRecord {
@@ -182,9 +308,9 @@ pub fn run_column<C: Column>(
         l_i: plan.l_i,
         h_i: plan.h_i,
         gravity: plan.gravity,
-        history: &history,
+        history: &b.history,
         h_f: height,
-        rest_since,
+        rest_since: b.rest_since,
         at_rest,
         t_end,
         dt: tally.dt,

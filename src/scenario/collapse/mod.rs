@@ -213,10 +213,13 @@ where
     Ok(summary)
 }
 
+/// Writes a checkpoint of a column and the runner's bookkeeping; returns the file.
+type Save<'h, C> = &'h dyn Fn(&C, &Bookkeeping) -> Result<PathBuf>;
+
 /// How [`run_loop`] checkpoints: when and how to save, and where it resumes from.
 struct Hooks<'h, C> {
     control: &'h Control,
-    save: Option<&'h dyn Fn(&C, &Bookkeeping) -> Result<PathBuf>>,
+    save: Option<Save<'h, C>>,
     resumed: Option<Bookkeeping>,
 }
 

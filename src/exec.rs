@@ -22,6 +22,38 @@ pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> Result<R> + Send)
         .install(f)
 }
 
+/// Σ_{i < n} f(i), in parallel yet the same to the last bit at every run and on any number of
+/// threads: 0..n is cut into fixed chunks of `chunk`, each summed in index order, and the
+/// chunk sums are added in order ([`add_in_order`]). A rayon `sum`/`reduce` splits the work as
+/// threads steal it, so its rounding varies from run to run; a diagnostic that is written
+/// out, or a budget that accumulates over steps, must not (a resumed run repeats an
+/// uninterrupted one bit for bit).
+pub fn ordered_sum<const N: usize>(
+    n: usize,
+    chunk: usize,
+    f: impl Fn(usize) -> [f64; N] + Sync,
+) -> [f64; N] {
+    use rayon::prelude::*;
+    let parts: Vec<[f64; N]> = (0..n.div_ceil(chunk.max(1)))
+        .into_par_iter()
+        .map(|c| {
+            let end = ((c + 1) * chunk).min(n);
+            add_in_order((c * chunk..end).map(&f))
+        })
+        .collect();
+    add_in_order(parts)
+}
+
+/// The sum of `parts` in their order, component by component.
+pub fn add_in_order<const N: usize>(parts: impl IntoIterator<Item = [f64; N]>) -> [f64; N] {
+    parts.into_iter().fold([0.0; N], |mut a, p| {
+        for (a, p) in a.iter_mut().zip(p) {
+            *a += p;
+        }
+        a
+    })
+}
+
 /// Memory the machine can give a new process now (bytes): `MemAvailable` of `/proc/meminfo`;
 /// `None` where that is not known (not Linux).
 pub fn available_memory() -> Option<u64> {
@@ -63,6 +95,19 @@ pub const GIB: f64 = (1u64 << 30) as f64;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_ordered_sum_is_the_same_on_any_number_of_threads() {
+        // Terms of very different sizes, so that another order would round differently.
+        let f = |i: usize| [1.0 / (i as f64 + 1.0), (i as f64).sin() * 1e8];
+        let serial = add_in_order((0..100_000).map(f));
+        let on = |threads| on_threads(threads, || Ok(ordered_sum(100_000, 100_000, f))).unwrap();
+        assert_eq!(on(1), serial);
+        assert_eq!(on(2), serial);
+        let small = |threads| on_threads(threads, || Ok(ordered_sum(100_000, 512, f))).unwrap();
+        assert_eq!(small(1), small(3));
+        assert!((small(2)[0] - serial[0]).abs() < 1e-12 * serial[0]);
+    }
 
     #[test]
     fn median_of_odd_and_even_counts() {

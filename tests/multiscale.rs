@@ -4,6 +4,7 @@
 //! its code in `granflow::dem::periodic_cell` and `granflow::coupling::rve`, and against the
 //! wall-bounded biaxial test in `tests/dem_biaxial.rs`.
 
+use granflow::scenario::checkpointing::Control;
 use granflow::scenario::collapse::mpm::run_column_collapse_with;
 use granflow::scenario::mpm::spec::MaterialSpec;
 use granflow::scenario::mpm::MpmScenario;
@@ -27,10 +28,18 @@ fn a_column_of_volumes_runs_and_writes_their_state() {
     s.time.frame_interval_tc = 0.15;
     let dir = tempfile::tempdir().unwrap();
     let far = [10.0 * s.column.width, 0.0];
-    let err = run_column_collapse_with(&s, dir.path(), &[far], &mut |_, _| {}).unwrap_err();
+    let err = run_column_collapse_with(&s, dir.path(), &[far], Control::default(), &mut |_, _| {})
+        .unwrap_err();
     assert!(err.to_string().contains("--rve-frames"), "{err}");
     let centre = [0.5 * s.column.width, 0.5 * s.column.width];
-    let r = run_column_collapse_with(&s, dir.path(), &[centre], &mut |_, _| {}).unwrap();
+    let r = run_column_collapse_with(
+        &s,
+        dir.path(),
+        &[centre],
+        Control::default(),
+        &mut |_, _| {},
+    )
+    .unwrap();
     assert_eq!(r.solver, "mpm-rve");
     assert_eq!(r.points, 16);
     // The column slumps: some run-out, no point lost.

@@ -10,7 +10,10 @@ use std::time::{Duration, Instant};
 
 use granflow::scenario::checkpointing::Control;
 use granflow::scenario::collapse::dem::run_resumable_collapse;
+use granflow::scenario::collapse::mpm::run_column_collapse_with;
 use granflow::scenario::dem::DemScenario;
+use granflow::scenario::mpm::spec::MaterialSpec;
+use granflow::scenario::mpm::MpmScenario;
 use granflow::scenario::ScenarioFile;
 
 fn granflow() -> Command {
@@ -125,12 +128,25 @@ fn same_run(reference: &Path, resumed: &Path) {
     let names = |f: &[(String, Vec<u8>)]| f.iter().map(|x| x.0.clone()).collect::<Vec<_>>();
     assert_eq!(names(&a), names(&b));
     for ((name, x), (_, y)) in a.iter().zip(&b) {
-        assert!(
-            x == y,
-            "{name} differs between the uninterrupted and the resumed run:\n{}\n{}",
-            String::from_utf8_lossy(&x[..x.len().min(3000)]),
-            String::from_utf8_lossy(&y[..y.len().min(3000)])
-        );
+        if x != y {
+            let at = x
+                .iter()
+                .zip(y)
+                .position(|(p, q)| p != q)
+                .unwrap_or(x.len().min(y.len()));
+            let line = |v: &[u8]| {
+                let start = v[..at.min(v.len())]
+                    .iter()
+                    .rposition(|&c| c == b'\n')
+                    .map_or(0, |k| k + 1);
+                String::from_utf8_lossy(&v[start..(start + 400).min(v.len())]).into_owned()
+            };
+            panic!(
+                "{name} differs between the uninterrupted and the resumed run at byte {at}:\n{}\n---\n{}",
+                line(x),
+                line(y)
+            );
+        }
     }
     assert!(a.len() >= 6, "{:?}", names(&a));
 }
@@ -224,10 +240,10 @@ fn a_resume_of_a_changed_scenario_or_a_folder_without_a_run_is_refused() {
 #[test]
 fn checkpoints_are_refused_where_a_kind_cannot_write_them() {
     let dir = tempfile::tempdir().unwrap();
-    let mpm = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/column_collapse/mpm_a2.toml");
+    let submerged = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/submerged/dense_a0.8.toml");
     let out = granflow()
         .arg("run")
-        .arg(mpm)
+        .arg(submerged)
         .arg("--out")
         .arg(dir.path())
         .args(["--checkpoint-every", "0.1"])
@@ -246,25 +262,26 @@ fn checkpoints_are_refused_where_a_kind_cannot_write_them() {
     );
 }
 
-/// A DEM collapse stopped at a row (as SIGTERM does, through the same flag), and one whose
-/// stop checkpoint is then deleted so that it resumes from its last periodic checkpoint with
-/// rows and frames written past it (as after a SIGKILL), both end as the uninterrupted run.
-#[test]
-fn a_dem_collapse_stopped_or_killed_part_way_resumes_to_the_uninterrupted_result() {
-    let text = std::fs::read_to_string(data("resume_dem.toml")).unwrap();
-    let s = DemScenario::from_toml(&text).unwrap();
+/// A collapse stopped at its 7th row (as SIGTERM does, through the same flag), and one whose
+/// stop checkpoint is then deleted so that it resumes from its last periodic checkpoint (every
+/// `every` s) with rows and frames written past it (as after a SIGKILL), both end as the
+/// uninterrupted run. `run` runs the collapse with a control into a folder.
+fn stopped_and_killed_runs_resume_to_the_uninterrupted_result(
+    text: &str,
+    every: f64,
+    run: impl Fn(Control, &Path, granflow::exec::Progress) -> granflow::Result<()>,
+) {
     let reference = tempfile::tempdir().unwrap();
-    let control = Control::new(&text, None, Arc::default()).unwrap();
-    let summary = run_resumable_collapse(&s, reference.path(), control, &mut |_, _| {}).unwrap();
-    assert!(summary.collapse.at_rest);
+    let control = Control::new(text, None, Arc::default()).unwrap();
+    run(control, reference.path(), &mut |_, _| {}).unwrap();
     for lost_stop_checkpoint in [false, true] {
         let dir = tempfile::tempdir().unwrap();
         let stop = Arc::new(AtomicUsize::new(0));
-        let control = Control::new(&text, Some(0.02), Arc::clone(&stop)).unwrap();
+        let control = Control::new(text, Some(every), Arc::clone(&stop)).unwrap();
         let mut rows = 0;
-        let e = run_resumable_collapse(&s, dir.path(), control, &mut |_, _| {
+        let e = run(control, dir.path(), &mut |_, _| {
             rows += 1;
-            if rows == 17 {
+            if rows == 7 {
                 stop.store(15, Ordering::Relaxed);
             }
         })
@@ -278,9 +295,88 @@ fn a_dem_collapse_stopped_or_killed_part_way_resumes_to_the_uninterrupted_result
         if lost_stop_checkpoint {
             std::fs::remove_file(&checkpoints[1].1).unwrap();
         }
-        let mut control = Control::new(&text, None, Arc::default()).unwrap();
+        let mut control = Control::new(text, None, Arc::default()).unwrap();
         control.resume = true;
-        run_resumable_collapse(&s, dir.path(), control, &mut |_, _| {}).unwrap();
+        run(control, dir.path(), &mut |_, _| {}).unwrap();
         same_run(reference.path(), dir.path());
     }
+}
+
+#[test]
+fn a_dem_collapse_stopped_or_killed_part_way_resumes_to_the_uninterrupted_result() {
+    let text = std::fs::read_to_string(data("resume_dem.toml")).unwrap();
+    let s = DemScenario::from_toml(&text).unwrap();
+    stopped_and_killed_runs_resume_to_the_uninterrupted_result(&text, 0.02, |c, dir, p| {
+        run_resumable_collapse(&s, dir, c, p).map(|_| ())
+    });
+}
+
+/// `models/column_collapse/<file>` cut down to a column `cells` cells wide in a box three
+/// times as long, released for `end_tc` τ_c.
+fn small_mpm(file: &str, cells: f64, end_tc: f64) -> (String, MpmScenario) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("models/column_collapse")
+        .join(file);
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut s = MpmScenario::from_toml(&text).unwrap();
+    s.column.width = cells * s.mpm.cell_size;
+    s.column.box_length = 3.0 * cells * s.mpm.cell_size;
+    s.time.end_tc = end_tc;
+    (text, s)
+}
+
+#[test]
+fn an_mpm_collapse_stopped_or_killed_part_way_resumes_to_the_uninterrupted_result() {
+    let (text, s) = small_mpm("mpm_a2.toml", 8.0, 1.0);
+    let every = 2.0 * s.time.series_interval_tc * s.derive().unwrap().tau_c;
+    stopped_and_killed_runs_resume_to_the_uninterrupted_result(&text, every, |c, dir, p| {
+        run_column_collapse_with(&s, dir, &[], c, p).map(|_| ())
+    });
+}
+
+/// The points' representative volumes (grains, contacts, springs) are part of the checkpoint.
+#[test]
+fn an_mpm_dem_collapse_stopped_or_killed_part_way_resumes_to_the_uninterrupted_result() {
+    let (text, mut s) = small_mpm("rve_a1.toml", 4.0, 0.3);
+    let MaterialSpec::Rve { grains, .. } = &mut s.material else {
+        panic!("rve_a1.toml is not an rve file");
+    };
+    *grains = 32;
+    let every = s.time.series_interval_tc * s.derive().unwrap().tau_c;
+    let centre = [0.5 * s.column.width, 0.5 * s.column.width];
+    stopped_and_killed_runs_resume_to_the_uninterrupted_result(&text, every, |c, dir, p| {
+        run_column_collapse_with(&s, dir, &[centre], c, p).map(|_| ())
+    });
+}
+
+/// A disk that fills up part-way (the temporary file frame 3 is written to is `/dev/full`):
+/// the run stops naming the last complete frame and checkpoint, leaves no partial file, and
+/// resumes to the uninterrupted result once the output can be written again.
+#[test]
+fn a_full_disk_stops_the_run_naming_its_last_frame_and_checkpoint_and_it_resumes() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let child = spawn(&["--checkpoint-every", "2.0"], &out);
+    wait_for(&out, Some("fluid_000000.vti"));
+    std::os::unix::fs::symlink("/dev/full", out.join(".fluid_000003.vti.tmp")).unwrap();
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{stderr}");
+    for said in [
+        "No space left on device",
+        "the last complete frame is",
+        "fluid_000002.vti",
+        "checkpoint_000000017920.ckpt",
+        "granflow resume",
+    ] {
+        assert!(stderr.contains(said), "{said}: {stderr}");
+    }
+    let hidden: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.') && n != ".granflow-run")
+        .collect();
+    assert!(hidden.is_empty(), "partial files left: {hidden:?}");
+    ok(&resume(&out));
+    same_run(reference(), &out);
 }

@@ -191,10 +191,14 @@ fn check_mpm(path: &Path) -> Result<ExitCode> {
 /// machines (docs/performance.md, "MPM×DEM"), for `check`'s run-time estimate.
 const RVE_NS_PER_GRAIN_STEP: f64 = 75.0;
 
-fn run_mpm(path: &Path, out: Out, volumes: &[[f64; 2]]) -> Result<ExitCode> {
-    let s = MpmScenario::from_file(path)?;
+fn run_mpm(
+    s: &MpmScenario,
+    path: &Path,
+    out: &Path,
+    volumes: &[[f64; 2]],
+    control: Control,
+) -> Result<ExitCode> {
     let d = s.derive()?;
-    let out = out.claim(d.memory_bytes())?;
     eprintln!(
         "{}: MPM column collapse, {} points -> {}",
         s.name,
@@ -203,7 +207,7 @@ fn run_mpm(path: &Path, out: Out, volumes: &[[f64; 2]]) -> Result<ExitCode> {
     );
     let end = (1e3 * s.time.end_tc) as u64;
     let r = with_progress(end, "milli-τ_c", |p| {
-        granflow::scenario::collapse::mpm::run_column_collapse_with(&s, out, volumes, p)
+        granflow::scenario::collapse::mpm::run_column_collapse_with(s, out, volumes, control, p)
     })
     .with_context(|| stopped(path, out))?;
     println!(
@@ -291,7 +295,12 @@ pub fn run(
             let (dir, control) = start(dem_memory(s.derive()?.grains))?;
             run_dem(&s, path, dir, control)
         }
-        Kind::Mpm => run_mpm(path, out, volumes),
+        Kind::Mpm => {
+            let s = MpmScenario::from_file(path)?;
+            granflow::scenario::collapse::mpm::check_volumes(&s, volumes)?;
+            let (dir, control) = start(s.derive()?.memory_bytes())?;
+            run_mpm(&s, path, dir, volumes, control)
+        }
         Kind::Submerged => run_submerged(path, out),
         Kind::Sweep => anyhow::bail!(
             "{} is a sweep file: run it with `granflow sweep {} --out DIR`",
@@ -314,7 +323,7 @@ fn run_submerged(path: &Path, out: Out) -> Result<ExitCode> {
 }
 
 /// The kinds whose runs write checkpoints and stop cleanly on SIGINT/SIGTERM.
-const RESUMABLE: [Kind; 2] = [Kind::Fluid, Kind::Dem];
+const RESUMABLE: [Kind; 3] = [Kind::Fluid, Kind::Dem, Kind::Mpm];
 
 fn read_text(path: &Path) -> Result<String> {
     std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
@@ -358,6 +367,11 @@ pub fn resume(dir: &Path) -> Result<ExitCode> {
             let s = DemScenario::from_file(&path)?;
             granflow::exec::check_memory(dem_memory(s.derive()?.grains) as u64)?;
             run_dem(&s, &path, dir, control)
+        }
+        Kind::Mpm => {
+            let s = MpmScenario::from_file(&path)?;
+            granflow::exec::check_memory(s.derive()?.memory_bytes() as u64)?;
+            run_mpm(&s, &path, dir, &[], control)
         }
         other => anyhow::bail!(
             "cannot resume {}: it holds a `{other}` run, and only {} runs write checkpoints so far",

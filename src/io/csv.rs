@@ -1,7 +1,7 @@
 //! Append-only CSV time series, flushed row by row.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 use crate::{Error, Result};
@@ -71,7 +71,8 @@ impl CsvTable {
 pub struct CsvWriter {
     path: PathBuf,
     columns: usize,
-    out: BufWriter<File>,
+    /// The file, written a whole line at a time (no buffer to flush).
+    out: File,
     line: String,
     /// Bytes in the file so far (header and rows).
     len: u64,
@@ -102,7 +103,7 @@ impl CsvWriter {
         let mut writer = CsvWriter {
             path: path.to_path_buf(),
             columns: header.len(),
-            out: BufWriter::new(file),
+            out: file,
             line: String::new(),
             len: 0,
         };
@@ -155,12 +156,12 @@ impl CsvWriter {
         }
         let mut file = file;
         file.set_len(len)
-            .and_then(|()| std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0)))
+            .and_then(|()| file.seek(SeekFrom::End(0)))
             .map_err(|e| Error::io(path, e))?;
         Ok(CsvWriter {
             path: path.to_path_buf(),
             columns,
-            out: BufWriter::new(file),
+            out: file,
             line: String::new(),
             len,
         })
@@ -181,11 +182,17 @@ impl CsvWriter {
         &self.path
     }
 
+    /// Append the line in one write; one that fails part-way (a full disk) is cut off again,
+    /// so the file holds whole rows only.
     fn write_line(&mut self) -> Result<()> {
-        self.out
-            .write_all(self.line.as_bytes())
-            .and_then(|()| self.out.flush())
-            .map_err(|e| Error::io(&self.path, e))?;
+        let written = self.out.write_all(self.line.as_bytes());
+        if let Err(e) = written {
+            let _ = self
+                .out
+                .set_len(self.len)
+                .and_then(|()| self.out.seek(SeekFrom::End(0)));
+            return Err(Error::io(&self.path, e));
+        }
         self.len += self.line.len() as u64;
         Ok(())
     }

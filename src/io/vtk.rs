@@ -163,12 +163,42 @@ fn attributes(path: &Path, what: &str, fields: &[Field], n: usize) -> Result<Vec
         .collect()
 }
 
-/// Serialises `vtk` as VTK XML to `path` through [`write_atomic`](super::write_atomic).
+/// Serialises `vtk` as VTK XML to `path` through [`write_atomic`](super::write_atomic). A
+/// failed write (a full disk) is reported as its own I/O error, which vtkio's XML writer
+/// would turn into a formatting error that does not say what happened.
 fn write_xml(path: &Path, vtk: Vtk) -> Result<()> {
     super::write_atomic(path, |w| {
-        vtk.write_xml(w)
-            .map_err(|e| std::io::Error::other(format!("VTK XML writer: {e}")))
+        let mut out = Recording { inner: w, error: None };
+        vtk.write_xml(&mut out).map_err(|e| {
+            out.error
+                .take()
+                .unwrap_or_else(|| std::io::Error::other(format!("VTK XML writer: {e}")))
+        })
     })
+}
+
+/// A writer that keeps the first I/O error of the writer it wraps.
+struct Recording<'a> {
+    inner: &'a mut dyn std::io::Write,
+    error: Option<std::io::Error>,
+}
+
+impl std::io::Write for Recording<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.inner.write(buf).map_err(|e| self.keep(e))
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush().map_err(|e| self.keep(e))
+    }
+}
+
+impl Recording<'_> {
+    /// Keep `e` (the first one) and hand on a copy of its kind and message.
+    fn keep(&mut self, e: std::io::Error) -> std::io::Error {
+        let copy = std::io::Error::new(e.kind(), e.to_string());
+        self.error.get_or_insert(e);
+        copy
+    }
 }
 
 fn new_vtk(data: DataSet) -> Vtk {

@@ -114,6 +114,9 @@ pub struct Lattice<T> {
     covered_rows: Vec<u32>,
 }
 
+/// Cells per chunk of the sums over the lattice ([`crate::exec::ordered_sum`]).
+const SUM_CHUNK: usize = 4096;
+
 /// A raw pointer that may cross threads; see the SAFETY notes where it is dereferenced.
 #[derive(Clone, Copy)]
 struct Shared<T>(*mut T);
@@ -786,11 +789,11 @@ impl<T: Real> Lattice<T> {
 
     /// Sum of all populations of fluid cells (total mass, lattice units), accumulated in f64.
     pub fn total_mass(&self) -> f64 {
-        (0..self.len())
-            .into_par_iter()
-            .filter(|&c| !self.solid[c])
-            .map(|c| self.populations(c).iter().map(|v| v.f64()).sum::<f64>())
-            .sum()
+        let mass = |c: usize| match self.solid[c] {
+            true => [0.0],
+            false => [self.populations(c).iter().map(|v| v.f64()).sum::<f64>()],
+        };
+        crate::exec::ordered_sum(self.len(), SUM_CHUNK, mass)[0]
     }
 
     /// Bytes of population storage.

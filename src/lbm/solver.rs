@@ -250,21 +250,18 @@ impl<T: Real> Lbm<T> {
     /// half-force shift), accumulated in f64, over the cells that are not solid and not
     /// `excluded` (e.g. nodes inside moving solids under Ladd's bounce-back).
     pub fn momentum(&self, excluded: impl Fn(usize) -> bool + Sync) -> [f64; 2] {
-        use rayon::prelude::*;
         let lat = &self.lattice;
-        (0..lat.len())
-            .into_par_iter()
-            .filter(|&c| !lat.is_solid(c) && !excluded(c))
-            .map(|c| {
+        crate::exec::ordered_sum(lat.len(), 4096, |c| {
+            let mut j = [0.0; 2];
+            if !lat.is_solid(c) && !excluded(c) {
                 let f = lat.populations(c);
-                let mut j = [0.0; 2];
                 for i in 0..Q {
                     j[0] += f[i].f64() * CX[i] as f64;
                     j[1] += f[i].f64() * CY[i] as f64;
                 }
-                j
-            })
-            .reduce(|| [0.0; 2], |a, b| [a[0] + b[0], a[1] + b[1]])
+            }
+            j
+        })
     }
 
     /// Fill `m` with the macroscopic fields.

@@ -46,7 +46,7 @@ pub enum WallKind {
 }
 
 /// Which side of the domain a wall bounds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Side {
     /// x = position, material at larger x.
     Left,
@@ -59,14 +59,50 @@ pub enum Side {
 }
 
 /// A wall on a grid line.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Wall {
     /// Which side.
     pub side: Side,
     /// Coordinate of the wall line (m); nodes at or beyond it are constrained.
     pub position: f64,
     /// Condition.
+    #[serde(with = "kind_state")]
     pub kind: WallKind,
+}
+
+/// [`WallKind`] in a checkpoint: every variant (the platen too), externally tagged, where the
+/// scenario files' form is tagged by a `kind` key (which compact binary formats cannot read
+/// back).
+mod kind_state {
+    use super::WallKind;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    #[derive(Serialize, Deserialize)]
+    enum State {
+        Fixed,
+        Roller,
+        Friction(f64),
+        Platen(f64),
+    }
+
+    pub fn serialize<S: Serializer>(k: &WallKind, s: S) -> Result<S::Ok, S::Error> {
+        match *k {
+            WallKind::Fixed => State::Fixed,
+            WallKind::Roller => State::Roller,
+            WallKind::Friction { mu } => State::Friction(mu),
+            WallKind::Platen { speed } => State::Platen(speed),
+        }
+        .serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<WallKind, D::Error> {
+        Ok(match State::deserialize(d)? {
+            State::Fixed => WallKind::Fixed,
+            State::Roller => WallKind::Roller,
+            State::Friction(mu) => WallKind::Friction { mu },
+            State::Platen(speed) => WallKind::Platen { speed },
+        })
+    }
 }
 
 impl Wall {

@@ -8,7 +8,7 @@ use super::boundary::Wall;
 pub type NodeSums = [f64; 5];
 
 /// The background grid.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Grid {
     /// Cells along x.
     pub nx: usize,

@@ -4,7 +4,7 @@
 use super::material::{MaterialState, Stress};
 
 /// The material points, with the per-point state `S` of their material law.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Points<S = MaterialState> {
     /// Position (m).
     pub pos: Vec<[f64; 2]>,
@@ -123,7 +123,7 @@ impl<S: Default> Points<S> {
 }
 
 /// Reused buffers of [`Points::permute`].
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct PermuteScratch<S> {
     s: Vec<f64>,
     v2: Vec<[f64; 2]>,

@@ -114,6 +114,35 @@ impl Control {
         Ok(Some(loaded))
     }
 
+    /// The error that ends a run in `out` whose output could not be written (e.g. a full
+    /// disk): what failed, the last complete frame (`frame`, a file name) and the last
+    /// checkpoint, from which `granflow resume` continues once the output can be written
+    /// again. Errors other than failed writes are returned as they are.
+    pub fn write_failed(
+        &self,
+        e: Error,
+        out: &Path,
+        frame: Option<&str>,
+        checkpoint: Option<&Path>,
+    ) -> Error {
+        if !matches!(e, Error::Io { .. }) {
+            return e;
+        }
+        let frame = frame.map_or("none".into(), |f| out.join(f).display().to_string());
+        let resume = match checkpoint {
+            Some(c) => format!(
+                "the last checkpoint is {}: free some space, then `granflow resume {}`",
+                c.display(),
+                out.display()
+            ),
+            None => "no checkpoint was written yet (see --checkpoint-every)".into(),
+        };
+        Error::Output {
+            path: out.to_path_buf(),
+            reason: format!("{e}; the last complete frame is {frame}, {resume}"),
+        }
+    }
+
     /// The error that ends a run stopped by `signal` after saving `checkpoint`.
     pub fn interrupted(
         &self,

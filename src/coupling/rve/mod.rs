@@ -41,7 +41,7 @@ use crate::scale::substeps;
 
 /// The representative-volume material: one prepared packing, copied to every point and
 /// driven to the point's initial stress.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct RveMaterial {
     template: PeriodicCell,
     servo: Servo,

@@ -67,7 +67,7 @@ pub struct CellEnergy {
 }
 
 /// The cell and its grains (structure of arrays).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct PeriodicCell {
     x: Vec<f64>,
     y: Vec<f64>,

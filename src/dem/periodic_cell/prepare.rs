@@ -249,7 +249,7 @@ pub enum Target {
 /// T = 1000 Δt. At rest when every controlled stress is within 1 % of p_t of its target and
 /// the r.m.s. fluctuation speed is below 10⁻⁴ √(p_t/ρ_s); every grain is stopped every 200
 /// steps within 5 %.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Servo {
     /// Mean diameter d̄ (m).
     pub mean_diameter: f64,

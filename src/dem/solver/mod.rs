@@ -452,18 +452,14 @@ impl Dem {
     pub fn energy(&self) -> Energy {
         let g = &self.grains;
         let grav = self.params.gravity;
-        let (k, r, p) = (0..g.len())
-            .into_par_iter()
-            .with_min_len(GRAIN_CHUNK)
-            .map(|i| {
-                let m = g.mass[i];
-                (
-                    0.5 * m * (g.vx[i] * g.vx[i] + g.vy[i] * g.vy[i]),
-                    0.5 * g.inertia[i] * g.omega[i] * g.omega[i],
-                    -m * (grav[0] * g.x[i] + grav[1] * g.y[i]),
-                )
-            })
-            .reduce(|| (0.0, 0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2));
+        let [k, r, p] = crate::exec::ordered_sum(g.len(), GRAIN_CHUNK, |i| {
+            let m = g.mass[i];
+            [
+                0.5 * m * (g.vx[i] * g.vx[i] + g.vy[i] * g.vy[i]),
+                0.5 * g.inertia[i] * g.omega[i] * g.omega[i],
+                -m * (grav[0] * g.x[i] + grav[1] * g.y[i]),
+            ]
+        });
         let mut e = self.budget;
         if !self.forces_valid {
             // Springs not evaluated yet: history is zero except normal overlap.

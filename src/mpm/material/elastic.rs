@@ -5,7 +5,7 @@
 use super::{jaumann, Failure, Material, MaterialState, Strain, Stress};
 
 /// Linear isotropic elasticity.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub struct LinearElastic {
     /// Density ρ (kg/m³).
     pub density: f64,

@@ -27,7 +27,7 @@ pub type Strain = [f64; 3];
 
 /// Per-point history of the built-in laws (no heap object per point: one of these per point,
 /// stored in a `Vec` beside the other point arrays).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MaterialState {
     /// Accumulated equivalent plastic shear strain, Σ √(2/3 Δε^p_dev : Δε^p_dev).
     pub plastic_strain: f64,
@@ -100,7 +100,7 @@ pub fn jaumann(s: &Stress, w: f64) -> Stress {
 
 /// The materials a scenario can choose (enum dispatch keeps the hot loop free of virtual
 /// calls).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub enum MaterialModel {
     /// Linear isotropic elasticity.
     Elastic(LinearElastic),

@@ -29,7 +29,7 @@ use super::{Failure, Material, MaterialState, Strain, Stress};
 /// Mohr–Coulomb parameters, with the constants of the return mapping (k, m, σ_c, apex, λ,
 /// 2G) derived once in [`MohrCoulomb::new`] rather than per call (they need sin/cos of the
 /// angles, which otherwise cost a third of the update).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub struct MohrCoulomb {
     elastic: LinearElastic,
     friction_angle: f64,
@@ -40,7 +40,7 @@ pub struct MohrCoulomb {
 }
 
 /// Constants derived from the parameters (see the module doc for the formulas).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 struct Derived {
     k: f64,
     m: f64,

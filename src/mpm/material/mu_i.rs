@@ -21,7 +21,7 @@ use super::mohr_coulomb::MohrCoulomb;
 use super::{Failure, Material, MaterialState, Strain, Stress};
 
 /// The μ(I) Mohr–Coulomb material.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub struct MuIMohrCoulomb {
     /// The rate-independent material at φ_s (elasticity, ψ, c, σ_t and the I → 0 limit).
     base: MohrCoulomb,

@@ -83,7 +83,7 @@ pub enum Scheme {
 }
 
 /// Solver parameters.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct MpmParams {
     /// Shape functions.
     pub shape: ShapeKind,
@@ -107,7 +107,7 @@ pub struct MpmParams {
 }
 
 /// Energies (J per m of thickness) of the MPM system.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MpmEnergy {
     /// Σ ½ m_p |v_p|².
     pub kinetic: f64,
@@ -191,7 +191,7 @@ impl Transfer {
 }
 
 /// A pressure load on one boundary face of a point's domain (see the module doc).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Traction {
     /// Index of the point (kept valid when the points are re-sorted).
     pub point: u32,
@@ -208,7 +208,11 @@ const STRIPE: usize = 4;
 const CHUNK: usize = 512;
 
 /// The MPM system, generic over its constitutive law `M` (the built-in laws by default).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(bound(
+    serialize = "M: serde::Serialize, M::State: serde::Serialize",
+    deserialize = "M: serde::Deserialize<'de>, M::State: serde::Deserialize<'de>"
+))]
 pub struct Mpm<M: Material = MaterialModel> {
     /// Background grid.
     pub grid: Grid,
@@ -240,7 +244,7 @@ pub struct Mpm<M: Material = MaterialModel> {
 }
 
 /// Stencil of a point: first node (i, j) and 1-D weights and derivatives.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 struct Stencil {
     i0: i64,
     j0: i64,
@@ -621,23 +625,17 @@ impl<M: Material> Mpm<M> {
         let p = &self.points;
         let gv = self.params.gravity;
         let mat = &self.material;
-        let s = (0..p.len())
-            .into_par_iter()
-            .map(|q| {
-                let v = p.vel[q];
-                let m = p.mass[q];
-                let el = p.vol[q] * mat.elastic_energy_density(&p.stress[q], &p.state[q]);
-                [
-                    0.5 * m * (v[0] * v[0] + v[1] * v[1]),
-                    -m * (gv[0] * p.pos[q][0] + gv[1] * p.pos[q][1]),
-                    el,
-                    p.work[q] - el,
-                ]
-            })
-            .reduce(
-                || [0.0; 4],
-                |a, b| [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]],
-            );
+        let s = crate::exec::ordered_sum(p.len(), CHUNK, |q| {
+            let v = p.vel[q];
+            let m = p.mass[q];
+            let el = p.vol[q] * mat.elastic_energy_density(&p.stress[q], &p.state[q]);
+            [
+                0.5 * m * (v[0] * v[0] + v[1] * v[1]),
+                -m * (gv[0] * p.pos[q][0] + gv[1] * p.pos[q][1]),
+                el,
+                p.work[q] - el,
+            ]
+        });
         MpmEnergy {
             kinetic: s[0],
             potential: s[1],

@@ -257,38 +257,46 @@ impl<M: Material> Mpm<M> {
         let g = &mut self.grid;
         let (eps, dt, alpha) = (self.mass_eps, self.dt, self.params.damping);
         let walls = &g.walls;
-        let e = g
+        let node = |vn: &mut [f64; 2], v: &[f64; 2], s: &[f64; 5], mask, engaged: &mut u8| {
+            if s[0] <= eps {
+                *vn = [0.0; 2];
+                *engaged = 0;
+                return [0.0; 3];
+            }
+            let mut f = [s[3], s[4]];
+            let mut damp = 0.0;
+            if alpha > 0.0 {
+                for c in 0..2 {
+                    let fd = alpha * f[c].abs() * v[c].signum();
+                    f[c] -= fd;
+                    damp += fd * v[c] * dt;
+                }
+            }
+            *vn = [v[0] + dt * f[0] / s[0], v[1] + dt * f[1] / s[0]];
+            let (dn, dtan, on) = Grid::constrain_tracked(walls, mask, vn);
+            *engaged = on;
+            // Work of the wall impulse m Δv at the midpoint velocity (v^{n+1} + v^n)/2.
+            let mid = [0.5 * (vn[0] + v[0]), 0.5 * (vn[1] + v[1])];
+            let en = -s[0] * (dn[0] * mid[0] + dn[1] * mid[1]);
+            let et = -s[0] * (dtan[0] * mid[0] + dtan[1] * mid[1]);
+            [en, et, damp]
+        };
+        // Booked per fixed chunk and added in order, so that the budget is the same at every
+        // run ([`crate::exec::ordered_sum`]).
+        let parts: Vec<[f64; 3]> = g
             .vel_new
-            .par_iter_mut()
-            .zip(g.vel.par_iter())
-            .zip(g.sums.par_iter())
-            .zip(g.walls_mask.par_iter())
-            .zip(g.contact.par_iter_mut())
-            .map(|((((vn, v), s), &mask), engaged)| {
-                if s[0] <= eps {
-                    *vn = [0.0; 2];
-                    *engaged = 0;
-                    return [0.0; 3];
-                }
-                let mut f = [s[3], s[4]];
-                let mut damp = 0.0;
-                if alpha > 0.0 {
-                    for c in 0..2 {
-                        let fd = alpha * f[c].abs() * v[c].signum();
-                        f[c] -= fd;
-                        damp += fd * v[c] * dt;
-                    }
-                }
-                *vn = [v[0] + dt * f[0] / s[0], v[1] + dt * f[1] / s[0]];
-                let (dn, dtan, on) = Grid::constrain_tracked(walls, mask, vn);
-                *engaged = on;
-                // Work of the wall impulse m Δv at the midpoint velocity (v^{n+1} + v^n)/2.
-                let mid = [0.5 * (vn[0] + v[0]), 0.5 * (vn[1] + v[1])];
-                let en = -s[0] * (dn[0] * mid[0] + dn[1] * mid[1]);
-                let et = -s[0] * (dtan[0] * mid[0] + dtan[1] * mid[1]);
-                [en, et, damp]
+            .par_chunks_mut(CHUNK)
+            .zip(g.vel.par_chunks(CHUNK))
+            .zip(g.sums.par_chunks(CHUNK))
+            .zip(g.walls_mask.par_chunks(CHUNK))
+            .zip(g.contact.par_chunks_mut(CHUNK))
+            .map(|((((vn, v), s), mask), engaged)| {
+                crate::exec::add_in_order(
+                    (0..vn.len()).map(|k| node(&mut vn[k], &v[k], &s[k], mask[k], &mut engaged[k])),
+                )
             })
-            .reduce(|| [0.0; 3], |a, b| [a[0] + b[0], a[1] + b[1], a[2] + b[2]]);
+            .collect();
+        let e = crate::exec::add_in_order(parts);
         for (b, v) in self.booked.iter_mut().zip(e) {
             *b += v;
         }

@@ -31,7 +31,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::{run_column, run_resumable, steps_per_row, Column, Plan, Row, Tally};
+use super::{run_resumable, steps_per_row, Column, Plan, Row, Tally};
 use crate::analysis::runout::CollapseOutcome;
 use crate::dem::packing::deposit_column;
 use crate::dem::stress::grain_stress;
@@ -420,8 +420,7 @@ pub fn run_column_collapse(
     out_dir: &Path,
     progress: Progress,
 ) -> Result<CollapseSummary> {
-    let (column, plan) = column(scenario)?;
-    run_column(column, &plan, out_dir, progress)
+    run_resumable_collapse(scenario, out_dir, Control::default(), progress)
 }
 
 /// [`run_column_collapse`] with checkpoints, a stop on request and resume ([`Control`]): a

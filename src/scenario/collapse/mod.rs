@@ -253,53 +253,66 @@ fn run_loop<C: Column>(
     let t_run = Instant::now();
     let row_seconds = plan.series_interval_tc * tau_c;
     let mut values = Vec::with_capacity(header.len());
-    let (mut last, mut height);
-    loop {
-        let t = column.time();
-        let (r, shape) = column.measure()?;
-        b.history.push((t, r.runout));
-        values.clear();
-        values.extend([t, t / tau_c, r.runout, r.front, r.height]);
-        values.extend_from_slice(&r.values);
-        csv.row(&values)?;
-        if b.row % frame_every == 0 {
-            column.write_frame(&shape, out_dir, b.frame, t, &mut pvd)?;
-            b.frame += 1;
-        }
-        b.row += 1;
-        if r.kinetic < rest_limit {
-            let since = *b.rest_since.get_or_insert(t);
-            if t >= tau_c && t - since >= plan.rest_duration_tc * tau_c {
-                at_rest = true;
-            }
-        } else {
-            b.rest_since = None;
-        }
-        (last, height) = (shape, r.height);
-        progress((1e3 * t / tau_c) as u64, (1e3 * plan.end_tc) as u64);
-        if at_rest || t >= plan.end_tc * tau_c {
-            break;
-        }
-        column.advance()?;
-        let Some(save) = hooks.save else { continue };
-        let signal = hooks.control.stop_signal();
-        if hooks.control.due(b.row, row_seconds) || signal.is_some() {
-            b.series_bytes = csv.bytes_written();
-            b.pvd = pvd.entries().to_vec();
-            let wall = b.wall_time_s;
-            b.wall_time_s += t_run.elapsed().as_secs_f64();
-            let path = save(&column, &b)?;
-            b.wall_time_s = wall;
-            if let Some(signal) = signal {
-                // The state now, for a look; the resumed run writes its own frame of this
-                // number when one is due.
-                let (_, shape) = column.measure()?;
-                let t = column.time();
+    let (mut last, mut height) = (None, 0.0);
+    let mut last_checkpoint = None;
+    // Failed writes (a full disk) end the run naming its last frame and checkpoint.
+    let looped = (|| -> Result<()> {
+        loop {
+            let t = column.time();
+            let (r, shape) = column.measure()?;
+            b.history.push((t, r.runout));
+            values.clear();
+            values.extend([t, t / tau_c, r.runout, r.front, r.height]);
+            values.extend_from_slice(&r.values);
+            csv.row(&values)?;
+            if b.row % frame_every == 0 {
                 column.write_frame(&shape, out_dir, b.frame, t, &mut pvd)?;
-                return Err(hooks.control.interrupted(signal, b.row, t, path, out_dir));
+                b.frame += 1;
+            }
+            b.row += 1;
+            if r.kinetic < rest_limit {
+                let since = *b.rest_since.get_or_insert(t);
+                if t >= tau_c && t - since >= plan.rest_duration_tc * tau_c {
+                    at_rest = true;
+                }
+            } else {
+                b.rest_since = None;
+            }
+            (last, height) = (Some(shape), r.height);
+            progress((1e3 * t / tau_c) as u64, (1e3 * plan.end_tc) as u64);
+            if at_rest || t >= plan.end_tc * tau_c {
+                break;
+            }
+            column.advance()?;
+            let Some(save) = hooks.save else { continue };
+            let signal = hooks.control.stop_signal();
+            if hooks.control.due(b.row, row_seconds) || signal.is_some() {
+                b.series_bytes = csv.bytes_written();
+                b.pvd = pvd.entries().to_vec();
+                let wall = b.wall_time_s;
+                b.wall_time_s += t_run.elapsed().as_secs_f64();
+                let path = save(&column, &b)?;
+                last_checkpoint = Some(path.clone());
+                b.wall_time_s = wall;
+                if let Some(signal) = signal {
+                    // The state now, for a look; the resumed run writes its own frame of this
+                    // number when one is due.
+                    let (_, shape) = column.measure()?;
+                    let t = column.time();
+                    column.write_frame(&shape, out_dir, b.frame, t, &mut pvd)?;
+                    return Err(hooks.control.interrupted(signal, b.row, t, path, out_dir));
+                }
             }
         }
+        Ok(())
+    })();
+    if let Err(e) = looped {
+        let frame = pvd.entries().last().map(|f| f.file.as_str());
+        return Err(hooks
+            .control
+            .write_failed(e, out_dir, frame, last_checkpoint.as_deref()));
     }
+    let last = last.expect("the loop measures the column at least once");
     let wall_time_s = b.wall_time_s + t_run.elapsed().as_secs_f64();
     let t_end = column.time();
     if (b.row - 1) % frame_every != 0 {

@@ -28,7 +28,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::{run_column, steps_per_row, Column, Plan, Row, Tally};
+use super::{run_resumable, steps_per_row, Column, Plan, Row, Tally};
 use crate::analysis::runout::CollapseOutcome;
 use crate::coupling::RveMaterial;
 use crate::dem::periodic_cell::PeriodicCell;
@@ -36,7 +36,9 @@ use crate::exec::Progress;
 use crate::io::{write_vti, write_vtu_points, Field, ImageGrid, PvdSeries};
 use crate::mpm::material::{invariants, Material, MaterialModel, MaterialState};
 use crate::mpm::solver::{Mpm, MpmEnergy};
+use crate::scenario::checkpointing::Control;
 use crate::scenario::mpm::spec::{Law, MpmScenario};
+use crate::scenario::Kind;
 use crate::{Error, Result};
 
 /// What a material adds to the points' VTK output: named scalar arrays of its per-point
@@ -299,6 +301,11 @@ fn write_frame<M: PointOutput>(
 }
 
 /// An MPM column: the material points released between the floor and the walls.
+#[derive(Serialize, serde::Deserialize)]
+#[serde(bound(
+    serialize = "M: Serialize, M::State: Serialize",
+    deserialize = "M: serde::Deserialize<'de>, M::State: serde::Deserialize<'de>"
+))]
 pub struct MpmColumn<M: PointOutput = MaterialModel> {
     /// The continuum.
     pub mpm: Mpm<M>,
@@ -402,15 +409,16 @@ impl<M: PointOutput> Column for MpmColumn<M> {
     }
 }
 
-/// The plan of the run of `scenario` for a system `mpm` (at t = 0).
-fn plan<'a, M: Material>(scenario: &'a MpmScenario, mpm: &Mpm<M>, height: f64) -> Plan<'a> {
+/// The plan of the run of `scenario` for a column of initial `height` and potential energy
+/// `potential` (at t = 0).
+fn plan(scenario: &MpmScenario, height: f64, potential: f64) -> Plan<'_> {
     let ts = &scenario.time;
     Plan {
         name: &scenario.name,
         l_i: scenario.column.width,
         h_i: height,
         gravity: scenario.gravity,
-        potential: mpm.energy().potential,
+        potential,
         series_interval_tc: ts.series_interval_tc,
         frame_interval_tc: ts.frame_interval_tc,
         end_tc: ts.end_tc,
@@ -426,7 +434,7 @@ fn column_of<'a, M: PointOutput>(
     height: f64,
     tau_c: f64,
 ) -> (MpmColumn<M>, Plan<'a>) {
-    let plan = plan(scenario, &mpm, height);
+    let plan = plan(scenario, height, mpm.energy().potential);
     let series_steps = steps_per_row(scenario.time.series_interval_tc, tau_c, mpm.dt());
     let e0 = mpm.energy();
     (
@@ -454,47 +462,64 @@ pub fn run_column_collapse(
     out_dir: &Path,
     progress: Progress,
 ) -> Result<MpmCollapseSummary> {
-    run_column_collapse_with(scenario, out_dir, &[], progress)
+    run_column_collapse_with(scenario, out_dir, &[], Control::default(), progress)
 }
 
-/// [`run_column_collapse`], and with every frame the grains of the representative volumes of
-/// the points nearest `volumes` in the initial column (m; each within a cell of a point):
-/// `volume_<k>_<frame>.vtu`, part 2 + k of `series.pvd`, centred on the point.
+/// [`run_column_collapse`], checkpointing, stopping and resuming as `control` says (a resumed
+/// run takes its column, representative volumes included, from the checkpoint), and with
+/// every frame the grains of the representative volumes of the points nearest `volumes` in
+/// the initial column (m; each within a cell of a point): `volume_<k>_<frame>.vtu`, part
+/// 2 + k of `series.pvd`, centred on the point.
 pub fn run_column_collapse_with(
     scenario: &MpmScenario,
     out_dir: &Path,
     volumes: &[[f64; 2]],
+    control: Control,
     progress: Progress,
 ) -> Result<MpmCollapseSummary> {
+    check_volumes(scenario, volumes)?;
     let d = scenario.derive()?;
+    let plan_of = |height, potential| plan(scenario, height, potential);
     match &d.material {
         Law::Continuum(m) => {
-            if !volumes.is_empty() {
-                return Err(Error::Other(
-                    "--rve-frames: the points of this scenario hold no grains (material.model \
-                     is not \"rve\")"
-                        .into(),
-                ));
-            }
-            let mpm = scenario.build_with(*m, &d, |_| [0.0; 4])?;
-            let (column, plan) = column_of(scenario, mpm, d.height, d.tau_c);
-            run_column(column, &plan, out_dir, progress)
+            let start = || {
+                let mpm = scenario.build_with(*m, &d, |_| [0.0; 4])?;
+                Ok(column_of(scenario, mpm, d.height, d.tau_c))
+            };
+            run_resumable(Kind::Mpm, start, plan_of, out_dir, control, progress)
         }
         Law::Volume(v) => {
-            check_places(
-                volumes,
-                scenario.column.width,
-                d.height,
-                scenario.mpm.cell_size,
-            )?;
-            let material = v.material()?;
-            let geostatic = scenario.geostatic(&d, material.density(), v.k0);
-            let mpm = scenario.build_with(material, &d, geostatic)?;
-            let chosen = nearest_points(&mpm, volumes)?;
-            let (mut column, plan) = column_of(scenario, mpm, d.height, d.tau_c);
-            column.volumes = chosen;
-            run_column(column, &plan, out_dir, progress)
+            let start = || {
+                let material = v.material()?;
+                let geostatic = scenario.geostatic(&d, material.density(), v.k0);
+                let mpm = scenario.build_with(material, &d, geostatic)?;
+                let chosen = nearest_points(&mpm, volumes)?;
+                let (mut column, plan) = column_of(scenario, mpm, d.height, d.tau_c);
+                column.volumes = chosen;
+                Ok((column, plan))
+            };
+            run_resumable(Kind::Mpm, start, plan_of, out_dir, control, progress)
         }
+    }
+}
+
+/// Refuses, before anything is prepared or written, places of `--rve-frames` (`volumes`) in a
+/// scenario whose points hold no grains, or outside its initial column.
+pub fn check_volumes(scenario: &MpmScenario, volumes: &[[f64; 2]]) -> Result<()> {
+    let d = scenario.derive()?;
+    match &d.material {
+        Law::Continuum(_) if !volumes.is_empty() => Err(Error::Other(
+            "--rve-frames: the points of this scenario hold no grains (material.model is not \
+             \"rve\")"
+                .into(),
+        )),
+        Law::Continuum(_) => Ok(()),
+        Law::Volume(_) => check_places(
+            volumes,
+            scenario.column.width,
+            d.height,
+            scenario.mpm.cell_size,
+        ),
     }
 }
 

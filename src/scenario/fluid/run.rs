@@ -120,63 +120,73 @@ pub fn run(
     let dt = derived.units.dt;
     let checkpoint_every = control.every_steps(dt).unwrap_or(total);
     let mut result = Ok(());
-    while fluid.step_count() < total {
-        let s = fluid.step_count();
-        let next = [
-            next_multiple(s, derived.series_every),
-            next_multiple(s, derived.frame_every),
-            next_multiple(s, CHECK_EVERY),
-            next_multiple(s, checkpoint_every),
-            total,
-        ]
-        .into_iter()
-        .min()
-        .unwrap_or(total);
-        fluid.steps(next - s);
-        let s = fluid.step_count();
-        if let Err(e) = fluid.check_stable(STOP_MACH) {
-            result = Err(e);
-            break;
-        }
-        let row = s % derived.series_every == 0 || s == total;
-        if row {
-            state.row(fluid.as_ref(), &mut macro_)?;
-            if s * 2 >= total {
-                lift.push(fluid.obstacle_loads().0.first().map_or(0.0, |f| f[1]));
-            }
-        }
-        let frame = s % derived.frame_every == 0 || s == total;
-        if frame {
-            // A row just filled the fields; otherwise compute them for the frame.
-            if !row {
-                fluid.macroscopic(&mut macro_);
-            }
-            state.write_frame(&macro_, s as f64 * dt)?;
-        }
-        let signal = control.stop_signal().filter(|_| s < total);
-        if (control.due(s, dt) && s < total) || signal.is_some() {
-            let saved = Saved {
-                lbm: fluid.state(),
-                frames: state.frames,
-                series_bytes: state.series.bytes_written(),
-                pvd: state.pvd.entries().to_vec(),
-                lift: lift.clone(),
-                mass0,
-                wall_seconds: wall0 + start.elapsed().as_secs_f64(),
-            };
-            let path = control.save(out, Kind::Fluid, s, s as f64 * dt, &saved)?;
-            if let Some(signal) = signal {
-                // The fields as they are now, for a look; the resumed run writes its own
-                // frame of this number when one is due.
-                if !frame {
-                    fluid.macroscopic(&mut macro_);
-                    state.write_frame(&macro_, s as f64 * dt)?;
-                }
-                result = Err(control.interrupted(signal, s, s as f64 * dt, path, out));
+    let mut last_checkpoint = None;
+    // The loop's own errors are failed writes (a full disk): they end the run at once.
+    let looped = (|| -> Result<()> {
+        while fluid.step_count() < total {
+            let s = fluid.step_count();
+            let next = [
+                next_multiple(s, derived.series_every),
+                next_multiple(s, derived.frame_every),
+                next_multiple(s, CHECK_EVERY),
+                next_multiple(s, checkpoint_every),
+                total,
+            ]
+            .into_iter()
+            .min()
+            .unwrap_or(total);
+            fluid.steps(next - s);
+            let s = fluid.step_count();
+            if let Err(e) = fluid.check_stable(STOP_MACH) {
+                result = Err(e);
                 break;
             }
+            let row = s % derived.series_every == 0 || s == total;
+            if row {
+                state.row(fluid.as_ref(), &mut macro_)?;
+                if s * 2 >= total {
+                    lift.push(fluid.obstacle_loads().0.first().map_or(0.0, |f| f[1]));
+                }
+            }
+            let frame = s % derived.frame_every == 0 || s == total;
+            if frame {
+                // A row just filled the fields; otherwise compute them for the frame.
+                if !row {
+                    fluid.macroscopic(&mut macro_);
+                }
+                state.write_frame(&macro_, s as f64 * dt)?;
+            }
+            let signal = control.stop_signal().filter(|_| s < total);
+            if (control.due(s, dt) && s < total) || signal.is_some() {
+                let saved = Saved {
+                    lbm: fluid.state(),
+                    frames: state.frames,
+                    series_bytes: state.series.bytes_written(),
+                    pvd: state.pvd.entries().to_vec(),
+                    lift: lift.clone(),
+                    mass0,
+                    wall_seconds: wall0 + start.elapsed().as_secs_f64(),
+                };
+                let path = control.save(out, Kind::Fluid, s, s as f64 * dt, &saved)?;
+                last_checkpoint = Some(path.clone());
+                if let Some(signal) = signal {
+                    // The fields as they are now, for a look; the resumed run writes its own
+                    // frame of this number when one is due.
+                    if !frame {
+                        fluid.macroscopic(&mut macro_);
+                        state.write_frame(&macro_, s as f64 * dt)?;
+                    }
+                    result = Err(control.interrupted(signal, s, s as f64 * dt, path, out));
+                    break;
+                }
+            }
+            progress(s, total);
         }
-        progress(s, total);
+        Ok(())
+    })();
+    if let Err(e) = looped {
+        let frame = state.pvd.entries().last().map(|f| f.file.as_str());
+        return Err(control.write_failed(e, out, frame, last_checkpoint.as_deref()));
     }
     let wall = wall0 + start.elapsed().as_secs_f64();
     let cells = (derived.cells[0] * derived.cells[1]) as f64;

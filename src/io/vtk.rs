@@ -168,7 +168,10 @@ fn attributes(path: &Path, what: &str, fields: &[Field], n: usize) -> Result<Vec
 /// would turn into a formatting error that does not say what happened.
 fn write_xml(path: &Path, vtk: Vtk) -> Result<()> {
     super::write_atomic(path, |w| {
-        let mut out = Recording { inner: w, error: None };
+        let mut out = Recording {
+            inner: w,
+            error: None,
+        };
         vtk.write_xml(&mut out).map_err(|e| {
             out.error
                 .take()

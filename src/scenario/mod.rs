@@ -211,6 +211,22 @@ pub(crate) fn lattice_units(
 }
 
 /// Refuse `v` unless it is finite and > 0, naming `field` (the scenario key).
+/// Most lattice cells a scenario may ask for: ≈ 3.7 TB at 367 bytes per cell, so only a
+/// mistyped cell size reaches it.
+const MAX_CELLS: f64 = 1e10;
+
+/// Refuses a lattice of `nx` × `ny` cells beyond [`MAX_CELLS`], naming the cell size `field`.
+pub(crate) fn check_cells(field: &str, nx: usize, ny: usize) -> Result<()> {
+    let n = nx as f64 * ny as f64;
+    if n > MAX_CELLS {
+        return Err(Error::config(
+            field,
+            format!("{nx} × {ny} = {n:.3e} cells, more than the {MAX_CELLS:e} a run can hold"),
+        ));
+    }
+    Ok(())
+}
+
 pub(crate) fn positive(field: &str, v: f64) -> Result<()> {
     if v.is_finite() && v > 0.0 {
         Ok(())

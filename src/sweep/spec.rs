@@ -200,7 +200,12 @@ pub fn expand(spec: &SweepSpec, dir: &Path) -> Result<Vec<Case>> {
     let mut cases = Vec::new();
     for (&solver, base) in &spec.solvers {
         let base_path = dir.join(base);
-        let text = std::fs::read_to_string(&base_path).map_err(|e| Error::io(&base_path, e))?;
+        let text = std::fs::read_to_string(&base_path).map_err(|e| {
+            err(
+                format!("solvers.{}", solver.name()),
+                format!("cannot read {}: {e}", base_path.display()),
+            )
+        })?;
         let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
             err(format!("solvers.{}", solver.name()), e.to_string())
         })?;

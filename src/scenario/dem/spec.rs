@@ -328,5 +328,5 @@ impl DemScenario {
 /// 13 878 grains, run to 0.05 τ_c after the deposition: 9.3, 17.7 and 31.6 MiB; the estimate
 /// gives 11, 20 and 35 MiB.
 pub fn dem_memory(grains: usize) -> usize {
-    (8 << 20) + grains * 2048
+    (8usize << 20).saturating_add(grains.saturating_mul(2048))
 }

@@ -352,6 +352,7 @@ impl Scenario {
         positive("domain.size[1]", self.domain.size[1])?;
         let nx = whole_cells("domain.size[0]", self.domain.size[0], self.domain.dx)?;
         let ny = whole_cells("domain.size[1]", self.domain.size[1], self.domain.dx)?;
+        crate::scenario::check_cells("domain.dx", nx, ny)?;
         let (dx, nu, rho) = (self.domain.dx, self.fluid.viscosity, self.fluid.density);
         let units = lattice_units("time", dx, self.time.tau, self.time.dt, nu, rho)?;
         let tau = units.tau;

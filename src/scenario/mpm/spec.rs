@@ -495,6 +495,10 @@ fn mohr_coulomb(
 }
 
 /// n if `v` is within 1e-6 of the integer n ≥ 1.
+/// Most material points or grid cells a scenario may ask for (far beyond any machine's memory
+/// at ≈ 1.4 KiB per point, so only a mistyped cell size reaches it).
+const MAX_POINTS: f64 = 1e10;
+
 fn whole(v: f64) -> Option<usize> {
     let n = v.round();
     ((v - n).abs() < 1e-6 * v.max(1.0) && n >= 1.0).then_some(n as usize)
@@ -557,6 +561,18 @@ impl MpmScenario {
                 ),
             ));
         };
+        let cells_x = (c.box_length / h).ceil();
+        let points = (wc as f64) * (hc as f64) * (m.points_per_cell as f64).powi(2);
+        if points > MAX_POINTS || cells_x * (hc as f64) > MAX_POINTS {
+            return Err(Error::config(
+                "mpm.cell_size",
+                format!(
+                    "{h} m gives {points:.3e} points and {:.3e} grid cells, more than the \
+                     {MAX_POINTS:e} a run can hold: choose larger cells",
+                    cells_x * hc as f64
+                ),
+            ));
+        }
         check_wall("walls.base", &self.walls.base)?;
         check_wall("walls.back", &self.walls.back)?;
         check_wall("walls.end", &self.walls.end)?;
@@ -595,7 +611,7 @@ impl MpmScenario {
             height,
             tau_c: (height / self.gravity).sqrt(),
             points: wc * hc * n * n,
-            cells: [(c.box_length / h).ceil() as usize + 4, hc + 6],
+            cells: [cells_x as usize + 4, hc + 6],
             dt_cfl,
             wave_speed,
         })
@@ -699,9 +715,14 @@ impl DerivedMpm {
     /// 53 MiB.
     pub fn memory_bytes(&self) -> usize {
         let volumes = match &self.material {
-            Law::Volume(v) => self.points * v.preparation.grains * RVE_BYTES_PER_GRAIN,
+            Law::Volume(v) => self
+                .points
+                .saturating_mul(v.preparation.grains)
+                .saturating_mul(RVE_BYTES_PER_GRAIN),
             Law::Continuum(_) => 0,
         };
-        (8 << 20) + self.points * 1434 + volumes
+        (8usize << 20)
+            .saturating_add(self.points.saturating_mul(1434))
+            .saturating_add(volumes)
     }
 }

@@ -214,6 +214,7 @@ impl SubmergedScenario {
         };
         let nx = whole("column.box_length", self.column.box_length)?;
         let ny = whole("fluid.depth", f.depth)?;
+        crate::scenario::check_cells("coupling.dx", nx, ny)?;
         if f.depth <= dem.target_height + self.grains.d_max {
             return Err(Error::config(
                 "fluid.depth",

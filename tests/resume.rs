@@ -59,6 +59,16 @@ fn spawn(args: &[&str], out: &Path) -> Child {
         .unwrap()
 }
 
+/// Send SIGname to `child` (through the shell's own `kill`).
+fn signal(child: &Child, name: &str) {
+    let sent = Command::new("sh")
+        .arg("-c")
+        .arg(format!("kill -{name} {}", child.id()))
+        .status()
+        .unwrap();
+    assert!(sent.success());
+}
+
 /// Wait (at most a minute) until `file` exists in `dir` (`None`: any checkpoint).
 fn wait_for(dir: &Path, file: Option<&str>) {
     let start = Instant::now();
@@ -189,11 +199,7 @@ fn sigterm_saves_a_checkpoint_exits_143_and_resumes_to_the_uninterrupted_result(
     // No --checkpoint-every: the signal alone writes the checkpoint.
     let child = spawn(&[], dir.path());
     wait_for(dir.path(), Some("fluid_000001.vti"));
-    let killed = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(killed.success());
+    signal(&child, "TERM");
     let out = child.wait_with_output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(143), "{stderr}");
@@ -212,10 +218,7 @@ fn a_resume_of_a_changed_scenario_or_a_folder_without_a_run_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let child = spawn(&["--checkpoint-every", "2.0"], dir.path());
     wait_for(dir.path(), None);
-    Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
+    signal(&child, "INT");
     let out = child.wait_with_output().unwrap();
     assert_eq!(out.status.code(), Some(130));
     let copy = dir.path().join("scenario.toml");

@@ -277,35 +277,55 @@ pub fn run(
             RESUMABLE.map(|k| format!("`{k}`")).join(", ")
         );
     }
-    let start = |memory: usize| -> Result<(&Path, Control)> {
-        let text = read_text(path)?;
-        let control = Control::new(&text, checkpoint_every, super::stop_on_signals()?)?;
-        let dir = out.claim(memory)?;
-        keep_scenario(dir, &text)?;
-        Ok((dir, control))
-    };
     match kind {
-        Kind::Fluid => {
-            let s = Scenario::from_file(path)?;
-            let (dir, control) = start(s.derive()?.memory_bytes)?;
-            run_fluid(&s, path, dir, control)
-        }
-        Kind::Dem => {
-            let s = DemScenario::from_file(path)?;
-            let (dir, control) = start(dem_memory(s.derive()?.grains))?;
-            run_dem(&s, path, dir, control)
-        }
-        Kind::Mpm => {
-            let s = MpmScenario::from_file(path)?;
-            granflow::scenario::collapse::mpm::check_volumes(&s, volumes)?;
-            let (dir, control) = start(s.derive()?.memory_bytes())?;
-            run_mpm(&s, path, dir, volumes, control)
-        }
         Kind::Submerged => run_submerged(path, out),
         Kind::Sweep => anyhow::bail!(
             "{} is a sweep file: run it with `granflow sweep {} --out DIR`",
             path.display(),
             path.display()
+        ),
+        Kind::Fluid | Kind::Dem | Kind::Mpm => {
+            let text = read_text(path)?;
+            let control = Control::new(&text, checkpoint_every, super::stop_on_signals()?)?;
+            run_resumable(kind, path, volumes, control, |memory| {
+                let dir = out.claim(memory)?;
+                keep_scenario(dir, &text)?;
+                Ok(dir)
+            })
+        }
+    }
+}
+
+/// Parse the scenario at `path` of a resumable `kind`, take its output folder with
+/// `take(estimated peak memory)` and run it as `control` says.
+fn run_resumable<'a>(
+    kind: Kind,
+    path: &Path,
+    volumes: &[[f64; 2]],
+    control: Control,
+    take: impl FnOnce(usize) -> Result<&'a Path>,
+) -> Result<ExitCode> {
+    match kind {
+        Kind::Fluid => {
+            let s = Scenario::from_file(path)?;
+            let dir = take(s.derive()?.memory_bytes)?;
+            run_fluid(&s, path, dir, control)
+        }
+        Kind::Dem => {
+            let s = DemScenario::from_file(path)?;
+            let dir = take(dem_memory(s.derive()?.grains))?;
+            run_dem(&s, path, dir, control)
+        }
+        Kind::Mpm => {
+            let s = MpmScenario::from_file(path)?;
+            granflow::scenario::collapse::mpm::check_volumes(&s, volumes)?;
+            let dir = take(s.derive()?.memory_bytes())?;
+            run_mpm(&s, path, dir, volumes, control)
+        }
+        other => anyhow::bail!(
+            "{} holds a `{other}` scenario, and only {} runs write checkpoints so far",
+            path.display(),
+            RESUMABLE.map(|k| format!("`{k}`")).join(", ")
         ),
     }
 }
@@ -357,36 +377,19 @@ pub fn resume(dir: &Path) -> Result<ExitCode> {
     }
     let mut control = Control::new(&text, None, super::stop_on_signals()?)?;
     control.resume = true;
-    match kind {
-        Kind::Fluid => {
-            let s = Scenario::from_file(&path)?;
-            granflow::exec::check_memory(s.derive()?.memory_bytes as u64)?;
-            run_fluid(&s, &path, dir, control)
-        }
-        Kind::Dem => {
-            let s = DemScenario::from_file(&path)?;
-            granflow::exec::check_memory(dem_memory(s.derive()?.grains) as u64)?;
-            run_dem(&s, &path, dir, control)
-        }
-        Kind::Mpm => {
-            let s = MpmScenario::from_file(&path)?;
-            granflow::exec::check_memory(s.derive()?.memory_bytes() as u64)?;
-            run_mpm(&s, &path, dir, &[], control)
-        }
-        other => anyhow::bail!(
-            "cannot resume {}: it holds a `{other}` run, and only {} runs write checkpoints so far",
-            dir.display(),
-            RESUMABLE.map(|k| format!("`{k}`")).join(", ")
-        ),
-    }
+    run_resumable(kind, &path, &[], control, |memory| {
+        granflow::exec::check_memory(memory as u64)?;
+        Ok(dir)
+    })
 }
 
-/// Does the run in `dir` say it completed?
+/// Does the run in `dir` say it completed? A collapse writes `summary.json` when it ends; a
+/// fluid run also when it stops, with its `status`.
 fn completed(dir: &Path) -> bool {
     std::fs::read_to_string(dir.join("summary.json"))
         .ok()
         .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-        .is_some_and(|v| v["status"] == "completed")
+        .is_some_and(|v| v.get("status").is_none_or(|s| s == "completed"))
 }
 
 fn run_fluid(s: &Scenario, path: &Path, out: &Path, control: Control) -> Result<ExitCode> {

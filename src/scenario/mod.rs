@@ -211,9 +211,9 @@ pub(crate) fn lattice_units(
 }
 
 /// Refuse `v` unless it is finite and > 0, naming `field` (the scenario key).
-/// Most lattice cells a scenario may ask for: ≈ 3.7 TB at 367 bytes per cell, so only a
+/// Most lattice cells a scenario may ask for: ≈ 370 TB at 367 bytes per cell, so only a
 /// mistyped cell size reaches it.
-const MAX_CELLS: f64 = 1e10;
+const MAX_CELLS: f64 = 1e12;
 
 /// Refuses a lattice of `nx` × `ny` cells beyond [`MAX_CELLS`], naming the cell size `field`.
 pub(crate) fn check_cells(field: &str, nx: usize, ny: usize) -> Result<()> {

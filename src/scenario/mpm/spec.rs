@@ -497,7 +497,7 @@ fn mohr_coulomb(
 /// n if `v` is within 1e-6 of the integer n ≥ 1.
 /// Most material points or grid cells a scenario may ask for (far beyond any machine's memory
 /// at ≈ 1.4 KiB per point, so only a mistyped cell size reaches it).
-const MAX_POINTS: f64 = 1e10;
+const MAX_POINTS: f64 = 1e12;
 
 fn whole(v: f64) -> Option<usize> {
     let n = v.round();

@@ -55,23 +55,19 @@ pub enum Error {
     /// A run was asked to stop (SIGINT, SIGTERM) and stopped at a step boundary with its
     /// state saved.
     #[error(
-        "stopped by {} at step {step} (t = {time:.6e} s); its state is saved in {}: continue \
-         with `granflow resume {}`",
+        "stopped by {} {at}; its state is saved in {}: continue with `{resume}`",
         signal_name(*.signal),
-        .checkpoint.display(),
-        .out.display()
+        .saved.display()
     )]
     Interrupted {
         /// The signal's number (SIGINT 2, SIGTERM 15).
         signal: i32,
-        /// Steps taken.
-        step: u64,
-        /// Simulated time in seconds.
-        time: f64,
-        /// The checkpoint written.
-        checkpoint: PathBuf,
-        /// The run's output folder.
-        out: PathBuf,
+        /// Where it stopped, e.g. `at step 1200 (t = 1.5e-1 s)`.
+        at: String,
+        /// The checkpoint written, or the folder holding the checkpoints.
+        saved: PathBuf,
+        /// The command that continues it.
+        resume: String,
     },
     /// Anything else, with a message.
     #[error("{0}")]

@@ -83,6 +83,11 @@ enum Command {
         /// Cases run at the same time (0: one per core).
         #[arg(long, default_value_t = 0)]
         jobs: usize,
+        /// Save each case's state every SECONDS of simulated time, so that a sweep run again
+        /// after a crash or a kill continues its unfinished cases; SIGINT or SIGTERM always
+        /// save one before the cases stop.
+        #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+        checkpoint_every: Option<f64>,
     },
     /// Biaxial compression of a DEM collapse scenario's material: its peak and critical-state
     /// friction angles, the φ a Mohr–Coulomb continuum of that material needs. Writes
@@ -346,7 +351,12 @@ fn real_main() -> Result<ExitCode> {
             full,
             figures,
         } => cli::study::validate(&case, json, full, figures.as_deref()),
-        Command::Sweep { sweep, out, jobs } => cli::study::sweep(&sweep, &out, jobs),
+        Command::Sweep {
+            sweep,
+            out,
+            jobs,
+            checkpoint_every,
+        } => cli::study::sweep(&sweep, &out, jobs, checkpoint_every),
         Command::Biaxial {
             scenario,
             out,

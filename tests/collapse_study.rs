@@ -43,7 +43,7 @@ fn quick_sweep_reduced_shows_the_ordering_and_bands() {
     let sweep = dir.path().join("sweep.toml");
     std::fs::write(&sweep, reduced_sweep(&[0.5, 4.0])).unwrap();
     let out = dir.path().join("out");
-    let r = run_sweep(&sweep, &out, 0).unwrap();
+    let r = run_sweep(&sweep, &out, 0, None, Default::default()).unwrap();
     assert_eq!(r.cases.len(), 4);
     let get = |solver: Solver, a: &str| {
         let c = r
@@ -121,7 +121,7 @@ fn quick_sweep_reduced_shows_the_ordering_and_bands() {
         }
     }
     // Resumable: a second run reuses every case.
-    let again = run_sweep(&sweep, &out, 0).unwrap();
+    let again = run_sweep(&sweep, &out, 0, None, Default::default()).unwrap();
     assert!(again.cases.iter().all(|c| c.reused));
     assert_eq!(again.fits.mpm_vs_dem.len(), 2);
 }

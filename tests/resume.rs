@@ -383,3 +383,59 @@ fn a_full_disk_stops_the_run_naming_its_last_frame_and_checkpoint_and_it_resumes
     ok(&resume(&out));
     same_run(reference(), &out);
 }
+
+/// A sweep stopped before its cases start ends with the stop; one of its cases then stopped
+/// part-way (as a killed sweep leaves it) is continued from its checkpoint by the next run of
+/// the sweep, and every case ends as in a sweep that was never interrupted.
+#[test]
+fn a_sweep_continues_a_stopped_case_from_its_checkpoint() {
+    use granflow::sweep::{read_sweep, run_sweep};
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = dir.path().join("sweep.toml");
+    let base = data("resume_dem.toml");
+    std::fs::write(
+        &sweep,
+        format!(
+            "kind = \"sweep\"\nname = \"resume\"\ndescription = \"two small DEM collapses\"\n\
+             [solvers]\ndem = {:?}\n[[vary]]\n\"column.aspect_ratio\" = [1.0, 1.5]\n",
+            base.display().to_string()
+        ),
+    )
+    .unwrap();
+    let reference = dir.path().join("reference");
+    run_sweep(&sweep, &reference, 1, None, Arc::default()).unwrap();
+
+    let out = dir.path().join("out");
+    let e = run_sweep(&sweep, &out, 1, None, Arc::new(AtomicUsize::new(15))).unwrap_err();
+    assert!(
+        e.to_string().contains("2 of 2 cases unfinished")
+            && e.to_string().contains("granflow sweep"),
+        "{e}"
+    );
+    let (_, cases) = read_sweep(&sweep).unwrap();
+    let case = &cases[0];
+    let case_dir = out.join(&case.name);
+    std::fs::create_dir_all(&case_dir).unwrap();
+    std::fs::write(case_dir.join("scenario.toml"), &case.scenario).unwrap();
+    let s = DemScenario::from_toml(&case.scenario).unwrap();
+    let stop = Arc::new(AtomicUsize::new(0));
+    let control = Control::new(&case.scenario, Some(0.02), Arc::clone(&stop)).unwrap();
+    let mut rows = 0;
+    let stopped = run_resumable_collapse(&s, &case_dir, control, &mut |_, _| {
+        rows += 1;
+        if rows == 7 {
+            stop.store(2, Ordering::Relaxed);
+        }
+    });
+    assert!(matches!(
+        stopped,
+        Err(granflow::Error::Interrupted { signal: 2, .. })
+    ));
+
+    let r = run_sweep(&sweep, &out, 1, None, Arc::default()).unwrap();
+    assert!(r.cases.iter().all(|c| c.outcome.is_ok() && !c.reused));
+    assert!(r.cases[0].resumed && !r.cases[1].resumed);
+    for c in &r.cases {
+        same_run(&reference.join(&c.case.name), &out.join(&c.case.name));
+    }
+}

@@ -13,8 +13,14 @@ use granflow::scenario::ScenarioFile;
 
 use super::{with_progress, Out};
 
-pub fn sweep(path: &Path, out: &Path, jobs: usize) -> Result<ExitCode> {
-    let r = granflow::sweep::run_sweep(path, out, jobs)?;
+pub fn sweep(
+    path: &Path,
+    out: &Path,
+    jobs: usize,
+    checkpoint_every: Option<f64>,
+) -> Result<ExitCode> {
+    let stop = super::stop_on_signals()?;
+    let r = granflow::sweep::run_sweep(path, out, jobs, checkpoint_every, stop)?;
     for g in &r.fits.groups {
         let with: String = g.with.iter().map(|(p, v)| format!(" {p}={v}")).collect();
         match &g.law {

@@ -143,7 +143,8 @@ impl Control {
         }
     }
 
-    /// The error that ends a run stopped by `signal` after saving `checkpoint`.
+    /// The error that ends a run in `out` stopped by `signal` at `step` and `time` after
+    /// saving `checkpoint`.
     pub fn interrupted(
         &self,
         signal: i32,
@@ -154,10 +155,9 @@ impl Control {
     ) -> Error {
         Error::Interrupted {
             signal,
-            step,
-            time,
-            checkpoint,
-            out: out.to_path_buf(),
+            at: format!("at step {step} (t = {time:.6e} s)"),
+            saved: checkpoint,
+            resume: format!("granflow resume {}", out.display()),
         }
     }
 }

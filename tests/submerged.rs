@@ -106,7 +106,7 @@ fn tiny_collapse_runs_and_its_outputs_agree() {
     assert_eq!(d.cells, [192, 64]);
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path();
-    let r = run_submerged(&s, out, &mut |_, _| {}).unwrap();
+    let r = run_submerged(&s, out, Default::default(), &mut |_, _| {}).unwrap();
     assert!(r.grains >= 30, "{} grains", r.grains);
     assert_eq!(r.fluid.subcycles, d.subcycles);
 
@@ -334,7 +334,7 @@ fn f32_bgk_les_variant_runs() {
     s.coupling.smagorinsky = Some(0.1);
     s.time.end_tc = 0.5;
     let dir = tempfile::tempdir().unwrap();
-    let r = run_submerged(&s, dir.path(), &mut |_, _| {}).unwrap();
+    let r = run_submerged(&s, dir.path(), Default::default(), &mut |_, _| {}).unwrap();
     assert_eq!(r.fluid.precision, "f32");
     assert!(r.fluid.max_mach > 0.0 && r.fluid.max_mach < 0.5);
     assert!(r.fluid.pore_pressure_early_mean.is_finite());
@@ -397,7 +397,7 @@ fn mrt_rates_come_from_the_file_and_are_checked() {
     s.coupling.mrt = free.coupling.mrt;
     s.time.end_tc = 0.5;
     let dir = tempfile::tempdir().unwrap();
-    let r = run_submerged(&s, dir.path(), &mut |_, _| {}).unwrap();
+    let r = run_submerged(&s, dir.path(), Default::default(), &mut |_, _| {}).unwrap();
     assert!(r.fluid.max_mach > 0.0 && r.fluid.max_mach < 0.5);
     assert!(r.fluid.pore_pressure_early_mean.is_finite());
 }
@@ -413,7 +413,7 @@ fn ladd_method_runs() {
     s.coupling.tau = Some(0.6);
     s.time.end_tc = 0.5;
     let dir = tempfile::tempdir().unwrap();
-    let r = run_submerged(&s, dir.path(), &mut |_, _| {}).unwrap();
+    let r = run_submerged(&s, dir.path(), Default::default(), &mut |_, _| {}).unwrap();
     assert!(r.fluid.max_mach > 0.0 && r.fluid.max_mach < 0.5);
     assert!(r.fluid.pore_pressure_early_mean.is_finite());
     assert!(r.collapse.l_f > r.collapse.l_i);
@@ -431,7 +431,7 @@ fn base_pore_pressure_pair(loose: &str, dense: &str, end_tc: f64) -> (f64, f64) 
         s.time.end_tc = end_tc;
         s.time.frame_interval_tc = end_tc;
         let dir = tempfile::tempdir().unwrap();
-        let r = run_submerged(&s, dir.path(), &mut |_, _| {}).unwrap();
+        let r = run_submerged(&s, dir.path(), Default::default(), &mut |_, _| {}).unwrap();
         let csv = std::fs::read_to_string(dir.path().join("timeseries.csv")).unwrap();
         let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
         let col = |name: &str| header.iter().position(|h| *h == name).unwrap();

@@ -269,35 +269,24 @@ pub fn run(
             path.display()
         );
     }
-    if checkpoint_every.is_some() && !RESUMABLE.contains(&kind) {
+    if kind == Kind::Sweep {
         anyhow::bail!(
-            "--checkpoint-every: {} is a `{kind}` scenario, and only {} runs write checkpoints \
-             so far",
-            path.display(),
-            RESUMABLE.map(|k| format!("`{k}`")).join(", ")
-        );
-    }
-    match kind {
-        Kind::Submerged => run_submerged(path, out),
-        Kind::Sweep => anyhow::bail!(
             "{} is a sweep file: run it with `granflow sweep {} --out DIR`",
             path.display(),
             path.display()
-        ),
-        Kind::Fluid | Kind::Dem | Kind::Mpm => {
-            let text = read_text(path)?;
-            let control = Control::new(&text, checkpoint_every, super::stop_on_signals()?)?;
-            run_resumable(kind, path, volumes, control, |memory| {
-                let dir = out.claim(memory)?;
-                keep_scenario(dir, &text)?;
-                Ok(dir)
-            })
-        }
+        );
     }
+    let text = read_text(path)?;
+    let control = Control::new(&text, checkpoint_every, super::stop_on_signals()?)?;
+    run_resumable(kind, path, volumes, control, |memory| {
+        let dir = out.claim(memory)?;
+        keep_scenario(dir, &text)?;
+        Ok(dir)
+    })
 }
 
-/// Parse the scenario at `path` of a resumable `kind`, take its output folder with
-/// `take(estimated peak memory)` and run it as `control` says.
+/// Parse the scenario at `path` of `kind`, take its output folder with `take(estimated peak
+/// memory)` and run it as `control` says.
 fn run_resumable<'a>(
     kind: Kind,
     path: &Path,
@@ -322,28 +311,33 @@ fn run_resumable<'a>(
             let dir = take(s.derive()?.memory_bytes())?;
             run_mpm(&s, path, dir, volumes, control)
         }
-        other => anyhow::bail!(
-            "{} holds a `{other}` scenario, and only {} runs write checkpoints so far",
+        Kind::Submerged => {
+            let s = SubmergedScenario::from_file(path)?;
+            let dir = take(s.derive()?.memory_bytes)?;
+            run_submerged(&s, path, dir, control)
+        }
+        Kind::Sweep => anyhow::bail!(
+            "{} is a sweep file: run it with `granflow sweep {} --out DIR`",
             path.display(),
-            RESUMABLE.map(|k| format!("`{k}`")).join(", ")
+            path.display()
         ),
     }
 }
 
-fn run_submerged(path: &Path, out: Out) -> Result<ExitCode> {
-    let s = SubmergedScenario::from_file(path)?;
-    let out = out.claim(s.derive()?.memory_bytes)?;
+fn run_submerged(
+    s: &SubmergedScenario,
+    path: &Path,
+    out: &Path,
+    control: Control,
+) -> Result<ExitCode> {
     eprintln!("{}: submerged column collapse -> {}", s.name, out.display());
     let r = with_progress((1e3 * s.time.end_tc) as u64, "milli-τ_c", |p| {
-        granflow::scenario::collapse::submerged::run_submerged(&s, out, p)
+        granflow::scenario::collapse::submerged::run_submerged(s, out, control, p)
     })
     .with_context(|| stopped(path, out))?;
     println!("{}", r.done_line());
     Ok(ExitCode::SUCCESS)
 }
-
-/// The kinds whose runs write checkpoints and stop cleanly on SIGINT/SIGTERM.
-const RESUMABLE: [Kind; 3] = [Kind::Fluid, Kind::Dem, Kind::Mpm];
 
 fn read_text(path: &Path) -> Result<String> {
     std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))

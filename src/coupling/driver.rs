@@ -22,6 +22,17 @@ pub trait Exchange<F: Scale, S: Scale> {
     fn to_solid(&mut self, fluid: &F::Output, solid_in: &mut S::Input);
 }
 
+/// The fields a coupled pair last exchanged, and its clock ([`Coupled::exchanged`]).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct Exchanged<FI, FO, SI, SO> {
+    fluid_in: FI,
+    fluid_out: FO,
+    solid_in: SI,
+    solid_out: SO,
+    last_subcycles: u64,
+    steps: u64,
+}
+
 /// A fluid and a solid scale coupled through a map `M`.
 pub struct Coupled<F: Scale, S: Scale, M> {
     /// The fluid.
@@ -84,6 +95,35 @@ where
         self.last_subcycles = n;
         self.steps += 1;
         Ok(())
+    }
+
+    /// What the pair carries between steps besides the two scales and the map: the fields
+    /// they last exchanged and the clock.
+    pub fn exchanged(&self) -> Exchanged<F::Input, F::Output, S::Input, S::Output>
+    where
+        F::Input: Clone,
+        F::Output: Clone,
+        S::Input: Clone,
+        S::Output: Clone,
+    {
+        Exchanged {
+            fluid_in: self.fluid_in.clone(),
+            fluid_out: self.fluid_out.clone(),
+            solid_in: self.solid_in.clone(),
+            solid_out: self.solid_out.clone(),
+            last_subcycles: self.last_subcycles,
+            steps: self.steps,
+        }
+    }
+
+    /// Continue from what [`Coupled::exchanged`] returned.
+    pub fn set_exchanged(&mut self, e: Exchanged<F::Input, F::Output, S::Input, S::Output>) {
+        self.fluid_in = e.fluid_in;
+        self.fluid_out = e.fluid_out;
+        self.solid_in = e.solid_in;
+        self.solid_out = e.solid_out;
+        self.last_subcycles = e.last_subcycles;
+        self.steps = e.steps;
     }
 
     /// The solid input of the last step (the hydrodynamic loads held during its sub-cycles).

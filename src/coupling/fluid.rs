@@ -16,7 +16,7 @@ use crate::{Error, Result};
 
 /// What a solid scale hands the fluid (SI): the cells it covers, ascending, with the exact
 /// solid fraction ε and the solid velocity at each cell centre.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct SolidCover {
     /// Cell indices y·nx + x, ascending.
     pub cells: Vec<u32>,
@@ -32,7 +32,7 @@ pub struct SolidCover {
 
 /// What the fluid hands back: the hydrodynamic force on the solid in each covered cell
 /// (N per metre of depth), in the order of [`SolidCover::cells`].
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct CellForces {
     /// Force x.
     pub fx: Vec<f64>,
@@ -59,7 +59,40 @@ pub struct CoupledFluid<T> {
     pub ladd: BounceLinks,
 }
 
+/// What a coupled fluid carries from step to step: the fluid's own state ([`LbmState`]), the
+/// partially covered cells, the exchanged momentum and Ladd's links; with the scenario it was
+/// built from, what a checkpoint needs to continue it bit for bit.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct CoupledFluidState<T> {
+    lbm: LbmState,
+    partial: PartialCells<T>,
+    exchange: Vec<[f64; 2]>,
+    exchange_sum: (Vec<[f64; 2]>, u64),
+    ladd: BounceLinks,
+}
+
 impl<T: Real> CoupledFluid<T> {
+    /// A copy of the state that changes as it runs.
+    pub fn state(&self) -> CoupledFluidState<T> {
+        CoupledFluidState {
+            lbm: self.lbm.state(),
+            partial: self.partial.clone(),
+            exchange: self.exchange.clone(),
+            exchange_sum: self.exchange_sum.clone(),
+            ladd: self.ladd.clone(),
+        }
+    }
+
+    /// Continue from a state taken by [`CoupledFluid::state`] of a fluid built the same way.
+    pub fn set_state(&mut self, s: CoupledFluidState<T>) -> Result<()> {
+        self.lbm.set_state(s.lbm)?;
+        self.partial = s.partial;
+        self.exchange = s.exchange;
+        self.exchange_sum = s.exchange_sum;
+        self.ladd = s.ladd;
+        Ok(())
+    }
+
     /// The fluid `lbm` with no solid in it yet.
     pub fn new(lbm: Lbm<T>) -> Self {
         CoupledFluid {

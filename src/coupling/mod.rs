@@ -24,8 +24,8 @@ pub mod ladd;
 pub mod psm;
 pub mod rve;
 
-pub use driver::{Coupled, Exchange};
-pub use fluid::{CellForces, CoupledFluid, SolidCover};
+pub use driver::{Coupled, Exchange, Exchanged};
+pub use fluid::{CellForces, CoupledFluid, CoupledFluidState, SolidCover};
 pub use ladd::LaddMap;
 pub use psm::{DiskCover, Grid};
 pub use rve::RveMaterial;

@@ -8,7 +8,7 @@ use crate::scale::Scale;
 use crate::Result;
 
 /// What the DEM shows the other scales: grain kinematics, written into reused buffers.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct GrainView {
     /// Centres x.
     pub x: Vec<f64>,

@@ -3,7 +3,17 @@
 use num_traits::Float;
 
 /// A population value type. Implemented for `f32` and `f64`.
-pub trait Real: Float + Default + Send + Sync + std::fmt::Debug + std::iter::Sum + 'static {
+pub trait Real:
+    Float
+    + Default
+    + Send
+    + Sync
+    + std::fmt::Debug
+    + std::iter::Sum
+    + serde::Serialize
+    + serde::de::DeserializeOwned
+    + 'static
+{
     /// Name used in reports (`"f32"` or `"f64"`).
     const NAME: &'static str;
     /// Conversion from `f64` (rounds for `f32`).

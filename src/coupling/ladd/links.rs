@@ -40,7 +40,7 @@ use crate::units::Units;
 
 /// What a solid scale hands the fluid for Ladd's bounce-back (SI): the boundary links, the
 /// inside nodes, and the nodes covered and uncovered since the last hand-over.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct LinkCover {
     /// Outside fluid node x_f of each boundary link (y·nx + x).
     pub cell: Vec<u32>,
@@ -92,7 +92,7 @@ impl LinkCover {
 }
 
 /// What the fluid hands back (N per metre of depth), in the order of [`LinkCover`].
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct LinkForces {
     /// Force on the solid across each link, x, averaged over the last advance.
     pub fx: Vec<f64>,
@@ -106,7 +106,7 @@ pub struct LinkForces {
 }
 
 /// The boundary links of a lattice, in lattice units, and the momentum they exchange.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct BounceLinks {
     /// Outside node x_f.
     cf: Vec<u32>,

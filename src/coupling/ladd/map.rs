@@ -32,7 +32,7 @@ use crate::scale::Scale;
 const NONE: u32 = u32::MAX;
 
 /// Maps disks onto Ladd boundary links and sums link forces per grain.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct LaddMap {
     /// The lattice.
     pub grid: Grid,

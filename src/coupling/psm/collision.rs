@@ -36,7 +36,7 @@ pub fn weighting(eps: f64, tau: f64) -> f64 {
 ///
 /// `cells` must be sorted ascending and free of duplicates; the other arrays run parallel to
 /// it.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct PartialCells<T> {
     /// Cell indices y·nx + x, ascending.
     pub cells: Vec<u32>,

@@ -31,7 +31,7 @@ const BAND_ROWS: usize = 8;
 const GROUP_BANDS: usize = 8;
 
 /// The lattice the disks are drawn on.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Grid {
     /// Cells along x.
     pub nx: usize,
@@ -44,7 +44,7 @@ pub struct Grid {
 }
 
 /// One (cell, grain) overlap.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 struct Piece {
     cell: u32,
     grain: u32,
@@ -65,7 +65,7 @@ struct Piece {
 /// owns its cells), and the force sums per chunk (a chunk owns its grains). Within a cell the
 /// pieces are summed in grain order, and within a grain in band order, whatever the thread
 /// count.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct DiskCover {
     /// The lattice.
     pub grid: Grid,
@@ -285,7 +285,7 @@ impl DiskCover {
 
 /// The covered cells of one band, ascending: Σ_k ε_nk and the solid velocity
 /// Σ_k ε_nk u_nk / Σ_k ε_nk.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 struct BandCells {
     cells: Vec<u32>,
     total: Vec<f64>,

@@ -67,7 +67,7 @@ pub fn disk_rect(c: [f64; 2], r: f64, x0: f64, x1: f64, y0: f64, y1: f64) -> f64
 
 /// One horizontal cell edge y = j − c_y of a disk's bounding box, with what
 /// [`quadrant`] needs there: a = √(r² − y²) and the chord integrals at ±a (only for |y| < r).
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 struct RowEdge {
     y: f64,
     a: f64,
@@ -79,7 +79,7 @@ struct RowEdge {
 /// with the chord integrals at the cell edges computed once per disk: neighbouring cells share
 /// their edges, so a disk costs about 3 × (its diameter in cells) `asin`s instead of several
 /// per cell. [`DiskCells::area`] is bit for bit [`disk_rect`] of the same cell.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct DiskCells {
     r: f64,
     i0: i64,

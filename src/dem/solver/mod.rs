@@ -56,7 +56,7 @@ const GRAIN_CHUNK: usize = 1024;
 
 /// External loads held during [`Dem::advance_with`] (e.g. hydrodynamic force and torque from
 /// the fluid, seed eq. 5.53–5.54). Empty vectors mean none.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct ExternalLoads {
     /// Force x per grain.
     pub fx: Vec<f64>,

@@ -241,6 +241,14 @@ pub fn write_frame(
     pvd.add(time, 1, &cname)
 }
 
+impl super::Resumable for DemColumn {
+    type Saved<'s> = &'s DemColumn;
+    type Loaded = DemColumn;
+    fn saved(&self) -> &DemColumn {
+        self
+    }
+}
+
 /// A DEM column: the grains after deposition, released between the floor and the side walls.
 #[derive(Serialize, serde::Deserialize)]
 pub struct DemColumn {
@@ -441,5 +449,5 @@ pub fn run_resumable_collapse(
         )
     };
     let start = || column(scenario);
-    run_resumable(Kind::Dem, start, plan_of, out_dir, control, progress)
+    run_resumable(Kind::Dem, start, Ok, plan_of, out_dir, control, progress)
 }

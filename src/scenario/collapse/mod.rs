@@ -8,7 +8,7 @@
 //!   solid, so the runs compare directly) and the solid's own keys.
 //!
 //! What differs between the solids is a [`Column`]: [`dem`] (grains), [`mpm`] (material
-//! points), [`submerged`] (grains in a liquid). The loop is [`run_column`]: one time-series
+//! points), [`submerged`] (grains in a liquid). The loop is [`run_resumable`]: one time-series
 //! row per `series_interval_tc`, a frame every `frame_interval_tc`, and the end when the
 //! kinetic energy has stayed below `rest_kinetic_fraction` × the initial potential energy
 //! above the floor for `rest_duration_tc` τ_c (and t ≥ 1 τ_c; reported as `rest_time_tc`), or
@@ -124,23 +124,6 @@ impl Plan<'_> {
     }
 }
 
-/// Run `column` to rest by `plan`, writing into `out_dir` (created if missing); returns the
-/// summary also written to `summary.json`. `progress` is told the time in thousandths of τ_c.
-pub fn run_column<C: Column>(
-    column: C,
-    plan: &Plan,
-    out_dir: &Path,
-    progress: Progress,
-) -> Result<C::Summary> {
-    let never = Control::default();
-    let hooks = Hooks {
-        control: &never,
-        save: None,
-        resumed: None,
-    };
-    run_loop(column, plan, out_dir, hooks, progress)
-}
-
 /// What the runner itself has done by a time-series row, saved with the column in a
 /// checkpoint: rows and frames written, the rest test's clock, the run-out history, the
 /// length of the time series and the frames listed, and the wall time spent.
@@ -168,26 +151,37 @@ pub struct Saved<C> {
     run: Bookkeeping,
 }
 
+/// A column a checkpoint can hold: what is saved of it, and what is read back (the same
+/// encoding), from which the caller of [`run_resumable`] rebuilds it.
+pub trait Resumable: Column {
+    /// What a checkpoint holds (the column itself, by reference, for a DEM or MPM column).
+    type Saved<'s>: Serialize
+    where
+        Self: 's;
+    /// The same, read back.
+    type Loaded: DeserializeOwned;
+    /// The column's state now.
+    fn saved(&self) -> Self::Saved<'_>;
+}
+
 /// Run a `kind` collapse that checkpoints, stops and resumes as `control` says: the column
-/// comes from the newest checkpoint in `out_dir` when the run resumes, otherwise from
-/// `start` (deposition and release); `plan_of` derives the plan from H_i and the potential
-/// energy.
-pub fn run_resumable<'p, C>(
+/// comes from the newest checkpoint in `out_dir`, through `restore`, when the run resumes,
+/// otherwise from `start` (deposition and release); `plan_of` derives the plan from H_i and
+/// the potential energy.
+pub fn run_resumable<'p, C: Resumable>(
     kind: Kind,
     start: impl FnOnce() -> Result<(C, Plan<'p>)>,
+    restore: impl FnOnce(C::Loaded) -> Result<C>,
     plan_of: impl FnOnce(f64, f64) -> Plan<'p>,
     out_dir: &Path,
     mut control: Control,
     progress: Progress,
-) -> Result<C::Summary>
-where
-    C: Column + Serialize + DeserializeOwned,
-{
+) -> Result<C::Summary> {
     crate::io::run_dir::create(out_dir)?;
-    let (column, plan, resumed) = match control.load::<Saved<C>>(out_dir, kind)? {
+    let (column, plan, resumed) = match control.load::<Saved<C::Loaded>>(out_dir, kind)? {
         Some(l) => {
             let s = l.state;
-            (s.column, plan_of(s.h_i, s.potential), Some(s.run))
+            (restore(s.column)?, plan_of(s.h_i, s.potential), Some(s.run))
         }
         None => {
             let (column, plan) = start()?;
@@ -196,7 +190,7 @@ where
     };
     let save = |c: &C, run: &Bookkeeping| {
         let saved = Saved {
-            column: c,
+            column: c.saved(),
             h_i: plan.h_i,
             potential: plan.potential,
             run: run.clone(),
@@ -205,7 +199,7 @@ where
     };
     let hooks = Hooks {
         control: &control,
-        save: Some(&save),
+        save: &save,
         resumed,
     };
     let summary = run_loop(column, &plan, out_dir, hooks, progress)?;
@@ -219,7 +213,7 @@ type Save<'h, C> = &'h dyn Fn(&C, &Bookkeeping) -> Result<PathBuf>;
 /// How [`run_loop`] checkpoints: when and how to save, and where it resumes from.
 struct Hooks<'h, C> {
     control: &'h Control,
-    save: Option<Save<'h, C>>,
+    save: Save<'h, C>,
     resumed: Option<Bookkeeping>,
 }
 
@@ -284,14 +278,13 @@ fn run_loop<C: Column>(
                 break;
             }
             column.advance()?;
-            let Some(save) = hooks.save else { continue };
             let signal = hooks.control.stop_signal();
             if hooks.control.due(b.row, row_seconds) || signal.is_some() {
                 b.series_bytes = csv.bytes_written();
                 b.pvd = pvd.entries().to_vec();
                 let wall = b.wall_time_s;
                 b.wall_time_s += t_run.elapsed().as_secs_f64();
-                let path = save(&column, &b)?;
+                let path = (hooks.save)(&column, &b)?;
                 last_checkpoint = Some(path.clone());
                 b.wall_time_s = wall;
                 if let Some(signal) = signal {

@@ -300,6 +300,21 @@ fn write_frame<M: PointOutput>(
     pvd.add(mpm.time(), 1, &gname)
 }
 
+impl<M> super::Resumable for MpmColumn<M>
+where
+    M: PointOutput + Serialize + serde::de::DeserializeOwned,
+    M::State: Serialize + serde::de::DeserializeOwned,
+{
+    type Saved<'s>
+        = &'s MpmColumn<M>
+    where
+        M: 's;
+    type Loaded = MpmColumn<M>;
+    fn saved(&self) -> &MpmColumn<M> {
+        self
+    }
+}
+
 /// An MPM column: the material points released between the floor and the walls.
 #[derive(Serialize, serde::Deserialize)]
 #[serde(bound(
@@ -486,7 +501,7 @@ pub fn run_column_collapse_with(
                 let mpm = scenario.build_with(*m, &d, |_| [0.0; 4])?;
                 Ok(column_of(scenario, mpm, d.height, d.tau_c))
             };
-            run_resumable(Kind::Mpm, start, plan_of, out_dir, control, progress)
+            run_resumable(Kind::Mpm, start, Ok, plan_of, out_dir, control, progress)
         }
         Law::Volume(v) => {
             let start = || {
@@ -498,7 +513,7 @@ pub fn run_column_collapse_with(
                 column.volumes = chosen;
                 Ok((column, plan))
             };
-            run_resumable(Kind::Mpm, start, plan_of, out_dir, control, progress)
+            run_resumable(Kind::Mpm, start, Ok, plan_of, out_dir, control, progress)
         }
     }
 }

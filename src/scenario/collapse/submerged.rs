@@ -37,11 +37,11 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::dem::{energy_values, plan, shape, write_frame, Shape};
-use super::{run_column, Column, Plan, Row, Tally};
+use super::{run_resumable, Column, Plan, Resumable, Row, Tally};
 use crate::analysis::runout::CollapseOutcome;
 use crate::coupling::{
-    reduced_gravity, CellForces, Coupled, CoupledFluid, DiskCover, Exchange, Grid, LaddMap,
-    SolidCover,
+    reduced_gravity, CellForces, Coupled, CoupledFluid, CoupledFluidState, DiskCover, Exchange,
+    Exchanged, Grid, LaddMap, SolidCover,
 };
 use crate::dem::packing::deposit_column;
 use crate::dem::scale::GrainView;
@@ -50,8 +50,10 @@ use crate::exec::Progress;
 use crate::io::{write_vti, Field, ImageGrid, PvdSeries};
 use crate::lbm::{Edges, Fluid, FluidModel, Lattice, Lbm, Macroscopic, Obstacles, Real, STOP_MACH};
 use crate::scale::Scale;
+use crate::scenario::checkpointing::Control;
 use crate::scenario::fluid::Precision;
 use crate::scenario::submerged::spec::{CouplingMethod, DerivedSubmerged, SubmergedScenario};
+use crate::scenario::Kind;
 use crate::units::CS2;
 use crate::{Error, Result};
 
@@ -59,7 +61,7 @@ use crate::{Error, Result};
 /// metre of depth × thickness are the forces on the grains (N, N·m). Partially saturated
 /// cells through `cover`, or Ladd's bounce-back links through `ladd` when set (`cover` then
 /// only gives the solid fraction written to the frames).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct SlabCover {
     /// The disk ↔ cell map.
     pub cover: DiskCover,
@@ -181,12 +183,13 @@ impl SubmergedSummary {
 pub fn run_submerged(
     scenario: &SubmergedScenario,
     out_dir: &Path,
+    control: Control,
     progress: crate::exec::Progress,
 ) -> Result<SubmergedSummary> {
     let d = scenario.derive()?;
     match scenario.coupling.precision {
-        Precision::F32 => run_typed::<f32>(scenario, &d, out_dir, progress),
-        Precision::F64 => run_typed::<f64>(scenario, &d, out_dir, progress),
+        Precision::F32 => run_typed::<f32>(scenario, &d, out_dir, control, progress),
+        Precision::F64 => run_typed::<f64>(scenario, &d, out_dir, control, progress),
     }
 }
 
@@ -461,7 +464,7 @@ pub fn column<'a, T: Real>(
     let t0 = Instant::now();
     let deposit = deposit_column(&d.dem.column)?;
     let deposition_wall_time_s = t0.elapsed().as_secs_f64();
-    let (l_i, h_i) = (scenario.column.width, deposit.height);
+    let h_i = deposit.height;
     let f = &scenario.fluid;
     if h_i + scenario.grains.d_max > f.depth {
         return Err(Error::config(
@@ -481,6 +484,38 @@ pub fn column<'a, T: Real>(
     let mut params = d.dem.params.clone();
     params.gravity = reduced_gravity([0.0, -gmag], f.density, scenario.grains.density);
     let dem = Dem::new(deposit.grains, walls, params)?;
+    let mut column = assemble(scenario, d, dem, h_i)?;
+    column.packing_fraction = deposit.packing_fraction;
+    column.deposition_wall_time_s = deposition_wall_time_s;
+    column.coupled.solid.refresh_forces();
+    column.e0 = column.coupled.solid.energy();
+    let plan = submerged_plan(scenario, h_i, column.e0.potential);
+    Ok((column, plan))
+}
+
+/// The plan of the run of `scenario` for a column of initial height `h_i` and potential energy
+/// `potential`.
+fn submerged_plan(scenario: &SubmergedScenario, h_i: f64, potential: f64) -> Plan<'_> {
+    let l_i = scenario.column.width;
+    plan(
+        &scenario.name,
+        [l_i, h_i],
+        scenario.gravity,
+        potential,
+        &scenario.time,
+    )
+}
+
+/// The grains `dem` (deposited, released) of a column `h_i` high in the tank of `scenario`,
+/// coupled to the liquid at rest; its energy scale `e0` is left for the caller to set.
+fn assemble<'a, T: Real>(
+    scenario: &'a SubmergedScenario,
+    d: &'a DerivedSubmerged,
+    dem: Dem,
+    h_i: f64,
+) -> Result<SubmergedColumn<'a, T>> {
+    let l_i = scenario.column.width;
+    let gmag = scenario.gravity;
     let [nx, ny] = d.cells;
     let u = d.units;
     let edges = Edges::closed();
@@ -511,9 +546,7 @@ pub fn column<'a, T: Real>(
         },
         thickness: scenario.grains.thickness,
     };
-    let mut c = Coupled::new(fluid, dem, map);
-    c.solid.refresh_forces();
-    let e0 = c.solid.energy();
+    let c = Coupled::new(fluid, dem, map);
     let ts = &scenario.time;
     let tau_c = (h_i / gmag).sqrt();
     let series_steps = ((ts.series_interval_tc * tau_c / u.dt).round() as u64).max(1);
@@ -539,29 +572,104 @@ pub fn column<'a, T: Real>(
         view: GrainView::default(),
         strip,
     };
-    let plan = plan(&scenario.name, [l_i, h_i], gmag, e0.potential, ts);
-    let column = SubmergedColumn {
+    Ok(SubmergedColumn {
         scenario,
         derived: d,
         coupled: c,
         fields,
-        e0,
+        e0: Energy::default(),
         series_steps,
         pore: Vec::new(),
         max_mach: 0.0,
         h_i,
-        packing_fraction: deposit.packing_fraction,
-        deposition_wall_time_s,
-    };
-    Ok((column, plan))
+        packing_fraction: 0.0,
+        deposition_wall_time_s: 0.0,
+    })
+}
+
+/// What a checkpoint holds of a submerged column: the grains, the liquid, the map between
+/// them and what they last exchanged, and the column's own bookkeeping (the scenario and the
+/// lattice's layout come from the run's scenario).
+#[derive(Serialize, serde::Deserialize)]
+#[serde(bound(
+    serialize = "T: Serialize",
+    deserialize = "T: serde::de::DeserializeOwned"
+))]
+pub struct SubmergedState<T> {
+    fluid: CoupledFluidState<T>,
+    dem: Dem,
+    map: SlabCover,
+    exchanged: Exchanged<SolidCover, CellForces, ExternalLoads, GrainView>,
+    e0: Energy,
+    series_steps: u64,
+    pore: Vec<(f64, f64)>,
+    max_mach: f64,
+    h_i: f64,
+    packing_fraction: f64,
+    deposition_wall_time_s: f64,
+}
+
+impl<T: Real> Resumable for SubmergedColumn<'_, T> {
+    type Saved<'s>
+        = SubmergedState<T>
+    where
+        Self: 's;
+    type Loaded = SubmergedState<T>;
+    fn saved(&self) -> SubmergedState<T> {
+        let c = &self.coupled;
+        SubmergedState {
+            fluid: c.fluid.state(),
+            dem: c.solid.clone(),
+            map: c.map.clone(),
+            exchanged: c.exchanged(),
+            e0: self.e0,
+            series_steps: self.series_steps,
+            pore: self.pore.clone(),
+            max_mach: self.max_mach,
+            h_i: self.h_i,
+            packing_fraction: self.packing_fraction,
+            deposition_wall_time_s: self.deposition_wall_time_s,
+        }
+    }
+}
+
+/// The column of `scenario` as a checkpoint saved it.
+fn restore<'a, T: Real>(
+    scenario: &'a SubmergedScenario,
+    d: &'a DerivedSubmerged,
+    s: SubmergedState<T>,
+) -> Result<SubmergedColumn<'a, T>> {
+    let mut column = assemble(scenario, d, s.dem, s.h_i)?;
+    let c = &mut column.coupled;
+    c.fluid.set_state(s.fluid)?;
+    c.map = s.map;
+    c.set_exchanged(s.exchanged);
+    column.e0 = s.e0;
+    column.series_steps = s.series_steps;
+    column.pore = s.pore;
+    column.max_mach = s.max_mach;
+    column.packing_fraction = s.packing_fraction;
+    column.deposition_wall_time_s = s.deposition_wall_time_s;
+    Ok(column)
 }
 
 fn run_typed<T: Real>(
     scenario: &SubmergedScenario,
     d: &DerivedSubmerged,
     out_dir: &Path,
+    control: Control,
     progress: Progress,
 ) -> Result<SubmergedSummary> {
-    let (column, plan) = column::<T>(scenario, d)?;
-    run_column(column, &plan, out_dir, progress)
+    let start = || column::<T>(scenario, d);
+    let restore = |s| restore::<T>(scenario, d, s);
+    let plan_of = |h_i, potential| submerged_plan(scenario, h_i, potential);
+    run_resumable(
+        Kind::Submerged,
+        start,
+        restore,
+        plan_of,
+        out_dir,
+        control,
+        progress,
+    )
 }

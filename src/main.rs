@@ -46,8 +46,8 @@ enum Command {
         rve_frames: Vec<[f64; 2]>,
         /// Save the run's state every SECONDS of simulated time (the newest two checkpoints
         /// are kept, and removed when the run completes), so that `granflow resume` can
-        /// continue it after a crash or a kill. SIGINT or SIGTERM always
-        /// save one before the run stops.
+        /// continue it after a crash or a kill. SIGINT or SIGTERM always save one before the
+        /// run stops.
         #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
         checkpoint_every: Option<f64>,
     },

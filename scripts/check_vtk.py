@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Open granflow output files with VTK itself and print what VTK sees.
 
-Usage: check_vtk.py FILE [FILE ...]    (FILE: .vti, .vtu or .pvd)
+Usage: check_vtk.py [--json OUT] FILE [FILE ...]    (FILE: .vti, .vtu or .pvd)
 
 For each data set: the data set type, number of points and cells, dimensions / spacing /
 origin for images, then every point and cell array with its number of tuples, components and
@@ -11,7 +11,14 @@ collection XML is parsed here and every listed file is read in turn.
 
 Exits non-zero if VTK reports an error or a warning while reading, or if an array does not
 have one tuple per point/cell. (An empty data set is reported but is not an error.) Needs the `vtk` package (pip install vtk).
+
+With `--json OUT`, every .vti/.vtu file's arrays as VTK read them are also written to OUT:
+{file: {"points": [x, y, z, ...], "cell_types": [...], "point": {name: [values]},
+"cell": {name: [values]}}}, values flattened tuple by tuple (the tests compare them with what
+was written).
 """
+
+import json
 
 import os
 import sys
@@ -40,13 +47,25 @@ def watch(obj, observer):
     return obj
 
 
-def describe_arrays(kind, data, expected, problems):
+# Filled by describe() when --json is given: file label -> what VTK read.
+DUMP = None
+
+
+def flat(arr):
+    """Every value of a numeric VTK array, tuple by tuple."""
+    n = arr.GetNumberOfTuples() * arr.GetNumberOfComponents()
+    return [arr.GetValue(i) for i in range(n)]
+
+
+def describe_arrays(kind, data, expected, problems, dump=None):
     n = data.GetNumberOfArrays()
     for k in range(n):
         arr = data.GetAbstractArray(k)
         name = arr.GetName()
         ncomp = arr.GetNumberOfComponents()
         ntup = arr.GetNumberOfTuples()
+        if dump is not None:
+            dump[name] = flat(arr)
         ranges = []
         if hasattr(arr, "GetRange"):
             for c in range(ncomp):
@@ -69,7 +88,7 @@ def describe_arrays(kind, data, expected, problems):
         print(f"    ({kind} data: no arrays)")
 
 
-def describe(ds, label, problems):
+def describe(ds, label, problems, path=None):
     print(f"  {label}: {ds.GetClassName()}, {ds.GetNumberOfPoints()} points, "
           f"{ds.GetNumberOfCells()} cells")
     if ds.IsA("vtkImageData"):
@@ -85,8 +104,18 @@ def describe(ds, label, problems):
         print(f"    cell 0 point ids {ids}")
     if ds.GetNumberOfPoints() == 0 and ds.GetNumberOfCells() == 0:
         print("    (empty data set)")
-    describe_arrays("point", ds.GetPointData(), ds.GetNumberOfPoints(), problems)
-    describe_arrays("cell", ds.GetCellData(), ds.GetNumberOfCells(), problems)
+    entry = None
+    if DUMP is not None and path is not None:
+        entry = {"point": {}, "cell": {}, "points": [], "cell_types": []}
+        if ds.IsA("vtkPointSet") and ds.GetPoints() is not None:
+            entry["points"] = flat(ds.GetPoints().GetData())
+        if ds.IsA("vtkUnstructuredGrid"):
+            entry["cell_types"] = [ds.GetCellType(c) for c in range(ds.GetNumberOfCells())]
+        DUMP[path] = entry
+    describe_arrays("point", ds.GetPointData(), ds.GetNumberOfPoints(), problems,
+                    entry and entry["point"])
+    describe_arrays("cell", ds.GetCellData(), ds.GetNumberOfCells(), problems,
+                    entry and entry["cell"])
 
 
 def read_file(path, problems):
@@ -106,7 +135,7 @@ def read_file(path, problems):
     reader.Update()
     problems.extend(f"{path}: {m}" for m in observer.messages)
     print(f"{path}")
-    describe(reader.GetOutput(), os.path.basename(path), problems)
+    describe(reader.GetOutput(), os.path.basename(path), problems, path)
 
 
 def walk_composite(data, problems, label="block"):
@@ -157,6 +186,11 @@ def read_pvd(path, problems):
 
 
 def main(argv):
+    global DUMP
+    out = None
+    if len(argv) > 2 and argv[1] == "--json":
+        out, DUMP = argv[2], {}
+        argv = argv[:1] + argv[3:]
     if len(argv) < 2:
         print(__doc__, file=sys.stderr)
         return 2
@@ -177,6 +211,9 @@ def main(argv):
     messages = window.GetOutput().strip()
     if messages:
         problems.append(f"VTK printed: {messages}")
+    if out is not None:
+        with open(out, "w") as f:
+            json.dump(DUMP, f)
     if problems:
         print("PROBLEMS:")
         for p in problems:

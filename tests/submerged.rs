@@ -6,14 +6,14 @@
 //! closed in the tank (its walls push on both); the closed periodic budget is the
 //! `coupling-momentum` case.
 
+mod common;
+
 use std::path::Path;
 
 use granflow::scenario::collapse::submerged::run_submerged;
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::submerged::SubmergedScenario;
 use granflow::scenario::ScenarioFile;
-use vtkio::model::{Attribute, DataSet, Piece};
-use vtkio::Vtk;
 
 fn models() -> Vec<std::path::PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/submerged");
@@ -77,26 +77,9 @@ fn tiny() -> SubmergedScenario {
     s
 }
 
-/// The named cell array of a `.vti` (read with the z extent widened to one layer: vtkio's
-/// reader drops the cell arrays of a flat image, see tests/io_vtk.rs).
+/// The named cell array of a `.vti`.
 fn vti_array(path: &Path, name: &str) -> Vec<f64> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let widened = text.replace(" 0 0\"", " 0 1\"");
-    let vtk = Vtk::parse_xml(widened.as_bytes()).unwrap();
-    let DataSet::ImageData { pieces, .. } = vtk.data else {
-        panic!("{}: not image data", path.display())
-    };
-    let Piece::Inline(piece) = &pieces[0] else {
-        panic!("piece not inline")
-    };
-    for a in &piece.data.cell {
-        if let Attribute::DataArray(d) = a {
-            if d.name == name {
-                return d.data.clone().into_vec::<f64>().unwrap();
-            }
-        }
-    }
-    panic!("{}: no array {name}", path.display());
+    common::vtk::read(path).array(name).values.clone()
 }
 
 #[test]
@@ -129,7 +112,7 @@ fn tiny_collapse_runs_and_its_outputs_agree() {
     assert!(r.collapse.delta_l > 0.02 && r.collapse.l_f < s.column.box_length);
 
     // series.pvd: every time has the grains (0), contacts (1) and fluid (2) parts, all files
-    // there and readable by vtkio, no temporary file left.
+    // there and readable, no temporary file left.
     let pvd = std::fs::read_to_string(out.join("series.pvd")).unwrap();
     let mut times: Vec<(String, usize, String)> = Vec::new();
     for line in pvd.lines().filter(|l| l.contains("<DataSet")) {
@@ -150,7 +133,7 @@ fn tiny_collapse_runs_and_its_outputs_agree() {
         assert_eq!(chunk[0].0, chunk[2].0);
         assert_eq!([chunk[0].1, chunk[1].1, chunk[2].1], [0, 1, 2]);
         for (_, _, f) in chunk {
-            Vtk::import(out.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+            common::vtk::read(&out.join(f));
         }
     }
     for e in std::fs::read_dir(out).unwrap() {

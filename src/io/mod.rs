@@ -15,10 +15,13 @@ pub mod plot;
 pub mod pvd;
 pub mod run_dir;
 pub mod vtk;
+mod vtk_appended;
 
 pub use atomic::{write_atomic, write_atomic_bytes};
 pub use csv::{CsvTable, CsvWriter};
 pub use json::write_json;
 pub use plot::{write_png, write_svg};
 pub use pvd::{PvdEntry, PvdSeries};
-pub use vtk::{write_vti, write_vtu_points, Field, FieldData, ImageGrid};
+pub use vtk::{
+    write_vti, write_vtu_points, Compression, Field, FieldData, ImageGrid, Precision, VtkFormat,
+};

@@ -1,19 +1,18 @@
-//! VTK XML output through `vtkio`: `.vti` images (the LBM lattice, MPM grid) and `.vtu` point
-//! and line sets (DEM grains, contact force chains).
+//! VTK XML output: `.vti` images (the LBM lattice, MPM grid) and `.vtu` point and line sets
+//! (DEM grains, material points, contact force chains).
 //!
-//! Files are written uncompressed, little-endian, with inline base64 `binary` data arrays
-//! (`header_type="UInt64"`), which VTK and ParaView read directly. All field values and point
-//! coordinates are written as `Float64`, so they round-trip exactly. 2-D data is embedded in
-//! 3-D: points get `z = 0` and vectors get a zero third component, as ParaView expects.
+//! Files are little-endian VTK XML with the data arrays in the *appended raw binary* section
+//! (`header_type="UInt64"`), compressed by zlib (the default) or LZ4, or not at all, and
+//! with floating-point values as `Float64` (exact, the default) or `Float32`: see
+//! [`VtkFormat`], the `[vtk]` table of a scenario. VTK and ParaView read all of them
+//! directly. 2-D data is embedded in 3-D: points get `z = 0` and vectors a zero third
+//! component, as ParaView expects.
 
 use std::collections::HashSet;
 use std::path::Path;
 
-use vtkio::model::{
-    Attribute, Attributes, ByteOrder, CellType, Cells, DataArray, DataSet, ElementType, Extent,
-    ImageDataPiece, Piece, UnstructuredGridPiece, Version, VertexNumbers, Vtk,
-};
-
+use super::vtk_appended::{escape, Body, Values};
+pub use super::vtk_appended::{Compression, Precision, VtkFormat};
 use crate::{Error, Result};
 
 /// A uniform 2-D grid of `nx` × `ny` cells.
@@ -103,131 +102,81 @@ impl<'a> Field<'a> {
     }
 }
 
-/// Checks lengths and names of `fields` (`what` is "cell" or "point") and converts them to
-/// vtkio attributes.
-fn attributes(path: &Path, what: &str, fields: &[Field], n: usize) -> Result<Vec<Attribute>> {
+/// Checks the lengths and names of `fields` (`what` is "cell" or "point"; `n` values each).
+fn check_fields(path: &Path, what: &str, fields: &[Field], n: usize) -> Result<()> {
     let mut seen = HashSet::new();
-    fields
-        .iter()
-        .map(|f| {
-            if f.name.is_empty() {
-                return Err(Error::Other(format!(
-                    "{}: a {what} field has an empty name",
-                    path.display()
-                )));
-            }
-            if !seen.insert(f.name) {
-                return Err(Error::Other(format!(
-                    "{}: {what} field `{}` is given twice",
-                    path.display(),
-                    f.name
-                )));
-            }
-            if f.data.len() != n {
-                return Err(Error::Other(format!(
-                    "{}: {what} field `{}` has {} values, expected {n} (one per {what})",
-                    path.display(),
-                    f.name,
-                    f.data.len()
-                )));
-            }
-            Ok(Attribute::DataArray(match f.data {
-                FieldData::Scalar(v) => DataArray {
-                    name: f.name.to_owned(),
-                    elem: ElementType::Scalars {
-                        num_comp: 1,
-                        lookup_table: None,
-                    },
-                    data: v.to_vec().into(),
-                },
-                FieldData::Vector(v) => DataArray {
-                    name: f.name.to_owned(),
-                    elem: ElementType::Vectors,
-                    data: v
-                        .iter()
-                        .flat_map(|&[x, y]| [x, y, 0.0])
-                        .collect::<Vec<f64>>()
-                        .into(),
-                },
-                FieldData::Tensor(v) => DataArray {
-                    name: f.name.to_owned(),
-                    elem: ElementType::Tensors,
-                    data: v
-                        .iter()
-                        .flat_map(|&[xx, xy, yx, yy]| [xx, xy, 0.0, yx, yy, 0.0, 0.0, 0.0, 0.0])
-                        .collect::<Vec<f64>>()
-                        .into(),
-                },
-            }))
-        })
-        .collect()
+    for f in fields {
+        let bad = |reason: String| Err(Error::Other(format!("{}: {reason}", path.display())));
+        if f.name.is_empty() {
+            return bad(format!("a {what} field has an empty name"));
+        }
+        if !seen.insert(f.name) {
+            return bad(format!("{what} field `{}` is given twice", f.name));
+        }
+        if f.data.len() != n {
+            return bad(format!(
+                "{what} field `{}` has {} values, expected {n} (one per {what})",
+                f.name,
+                f.data.len()
+            ));
+        }
+    }
+    Ok(())
 }
 
-/// Serialises `vtk` as VTK XML to `path` through [`write_atomic`](super::write_atomic). A
-/// failed write (a full disk) is reported as its own I/O error, which vtkio's XML writer
-/// would turn into a formatting error that does not say what happened.
-fn write_xml(path: &Path, vtk: Vtk) -> Result<()> {
-    super::write_atomic(path, |w| {
-        let mut out = Recording {
-            inner: w,
-            error: None,
+/// Appends `fields` as the `PointData` or `CellData` element (`element`) of a piece, the
+/// first scalar, vector and tensor field marked active.
+fn write_fields(body: &mut Body, element: &str, fields: &[Field]) {
+    let mut active = String::new();
+    for (attr, kind) in [("Scalars", 0), ("Vectors", 1), ("Tensors", 2)] {
+        let first = fields.iter().find(|f| {
+            matches!(
+                (kind, f.data),
+                (0, FieldData::Scalar(_)) | (1, FieldData::Vector(_)) | (2, FieldData::Tensor(_))
+            )
+        });
+        if let Some(f) = first {
+            active.push_str(&format!(" {attr}=\"{}\"", escape(f.name)));
+        }
+    }
+    body.tag(3, &format!("<{element}{active}>"));
+    for f in fields {
+        let (ncomp, values) = match f.data {
+            FieldData::Scalar(v) => (1, v.to_vec()),
+            FieldData::Vector(v) => (3, v.iter().flat_map(|&[x, y]| [x, y, 0.0]).collect()),
+            FieldData::Tensor(v) => (
+                9,
+                v.iter()
+                    .flat_map(|&[xx, xy, yx, yy]| [xx, xy, 0.0, yx, yy, 0.0, 0.0, 0.0, 0.0])
+                    .collect(),
+            ),
         };
-        vtk.write_xml(&mut out).map_err(|e| {
-            out.error
-                .take()
-                .unwrap_or_else(|| std::io::Error::other(format!("VTK XML writer: {e}")))
-        })
-    })
+        body.array(4, f.name, ncomp, Values::Real(values));
+    }
+    body.tag(3, &format!("</{element}>"));
 }
 
-/// A writer that keeps the first I/O error of the writer it wraps.
-struct Recording<'a> {
-    inner: &'a mut dyn std::io::Write,
-    error: Option<std::io::Error>,
-}
-
-impl std::io::Write for Recording<'_> {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.inner.write(buf).map_err(|e| self.keep(e))
-    }
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.inner.flush().map_err(|e| self.keep(e))
-    }
-}
-
-impl Recording<'_> {
-    /// Keep `e` (the first one) and hand on a copy of its kind and message.
-    fn keep(&mut self, e: std::io::Error) -> std::io::Error {
-        let copy = std::io::Error::new(e.kind(), e.to_string());
-        self.error.get_or_insert(e);
-        copy
-    }
-}
-
-fn new_vtk(data: DataSet) -> Vtk {
-    Vtk {
-        version: Version::new_xml(1, 0),
-        title: String::new(),
-        byte_order: ByteOrder::LittleEndian,
-        file_path: None,
-        data,
-    }
+/// Writes `body` (data set `kind`) to `path` through [`write_atomic`](super::write_atomic).
+fn write_body(path: &Path, kind: &str, body: Body) -> Result<()> {
+    super::write_atomic(path, |w| body.finish(kind, w))
 }
 
 /// Writes a VTK XML ImageData file (`.vti`) for `grid`, with `cell_fields` as CELL data.
 ///
 /// Each field holds `nx · ny` values indexed row-major with x fastest: cell `(i, j)` is at
-/// `j · nx + i`. The whole extent is `0 nx 0 ny 0 0` in points. Values are written as
-/// `Float64` (exact); scalar fields get one component, vector fields three (`z = 0`). The
-/// first scalar and the first vector field are marked active.
-///
-/// `origin` and `spacing` are stored by vtkio as `f32` (about 7 significant digits); this only
-/// affects where ParaView draws the grid, not the field values.
+/// `j · nx + i`. The whole extent is `0 nx 0 ny 0 0` in points. Scalar fields get one
+/// component, vector fields three (`z = 0`), tensors nine; the first of each is marked active.
+/// Origin and spacing are written in full (`{:e}`, shortest round-trip form).
 ///
 /// Returns [`Error::Other`] naming the field if a field does not have `nx · ny` values, if two
 /// fields share a name, or if the grid is empty or has a non-positive or non-finite spacing.
 /// The file is written atomically.
-pub fn write_vti(path: &Path, grid: &ImageGrid, cell_fields: &[Field]) -> Result<()> {
+pub fn write_vti(
+    path: &Path,
+    grid: &ImageGrid,
+    cell_fields: &[Field],
+    format: &VtkFormat,
+) -> Result<()> {
     let bad = |reason: String| Err(Error::Other(format!("{}: {reason}", path.display())));
     if grid.nx == 0 || grid.ny == 0 {
         return bad(format!(
@@ -235,12 +184,12 @@ pub fn write_vti(path: &Path, grid: &ImageGrid, cell_fields: &[Field]) -> Result
             grid.nx, grid.ny
         ));
     }
-    let (Ok(nx), Ok(ny)) = (i32::try_from(grid.nx), i32::try_from(grid.ny)) else {
+    if i32::try_from(grid.nx).is_err() || i32::try_from(grid.ny).is_err() {
         return bad(format!(
             "image grid {} x {} is too large for VTK extents",
             grid.nx, grid.ny
         ));
-    };
+    }
     if !grid.spacing.iter().all(|d| d.is_finite() && *d > 0.0)
         || !grid.origin.iter().all(|o| o.is_finite())
     {
@@ -249,23 +198,27 @@ pub fn write_vti(path: &Path, grid: &ImageGrid, cell_fields: &[Field]) -> Result
             grid.origin, grid.spacing
         ));
     }
-    let cell = attributes(path, "cell", cell_fields, grid.num_cells())?;
-    let extent = Extent::Ranges([0..=nx, 0..=ny, 0..=0]);
-    let data = DataSet::ImageData {
-        extent: extent.clone(),
-        origin: [grid.origin[0] as f32, grid.origin[1] as f32, 0.0],
-        spacing: [grid.spacing[0] as f32, grid.spacing[1] as f32, 1.0],
-        meta: None,
-        pieces: vec![Piece::Inline(Box::new(ImageDataPiece {
-            extent,
-            data: Attributes {
-                point: Vec::new(),
-                cell,
-            },
-        }))],
-    };
-    write_xml(path, new_vtk(data))
+    check_fields(path, "cell", cell_fields, grid.num_cells())?;
+    let extent = format!("0 {} 0 {} 0 0", grid.nx, grid.ny);
+    let [ox, oy] = grid.origin;
+    let [dx, dy] = grid.spacing;
+    let attrs =
+        format!(" WholeExtent=\"{extent}\" Origin=\"{ox:e} {oy:e} 0\" Spacing=\"{dx:e} {dy:e} 1\"");
+    let mut body = Body::new(*format, IMAGE, &attrs);
+    body.tag(2, &format!("<Piece Extent=\"{extent}\">"));
+    body.tag(3, "<PointData/>");
+    write_fields(&mut body, "CellData", cell_fields);
+    body.tag(2, "</Piece>");
+    write_body(path, IMAGE, body)
 }
+
+/// The data set element of a `.vti` file.
+const IMAGE: &str = "ImageData";
+/// The data set element of a `.vtu` file.
+const UNSTRUCTURED: &str = "UnstructuredGrid";
+/// VTK's cell type numbers (`vtkCellType.h`).
+const VTK_VERTEX: u8 = 1;
+const VTK_LINE: u8 = 3;
 
 /// Writes a VTK XML UnstructuredGrid file (`.vtu`) of 2-D `points` (written with `z = 0`).
 ///
@@ -276,8 +229,8 @@ pub fn write_vti(path: &Path, grid: &ImageGrid, cell_fields: &[Field]) -> Result
 ///   force chains between grain centres.
 ///
 /// `point_fields` must have one value per point and `cell_fields` one value per cell (so per
-/// point when `lines` is empty). Values and coordinates are written as `Float64` (exact),
-/// connectivity and offsets as `UInt64`.
+/// point when `lines` is empty). Coordinates and values are written at the format's
+/// precision, connectivity and offsets as `Int64`, cell types as `UInt8`.
 ///
 /// An empty `points` slice gives a valid empty data set (zero points, zero cells), which VTK
 /// reads; fields must then be empty too.
@@ -290,80 +243,61 @@ pub fn write_vtu_points(
     point_fields: &[Field],
     lines: &[[u32; 2]],
     cell_fields: &[Field],
+    format: &VtkFormat,
 ) -> Result<()> {
     let n = points.len();
-    let cells = if lines.is_empty() {
-        Cells {
-            cell_verts: VertexNumbers::XML {
-                connectivity: (0..n as u64).collect(),
-                offsets: (1..=n as u64).collect(),
-            },
-            types: vec![CellType::Vertex; n],
-        }
-    } else {
-        if let Some((k, l)) = lines
-            .iter()
-            .enumerate()
-            .find(|(_, l)| l.iter().any(|&p| p as usize >= n))
-        {
-            return Err(Error::Other(format!(
-                "{}: line {k} joins points {} and {}, but there are only {n} points",
-                path.display(),
-                l[0],
-                l[1]
-            )));
-        }
-        Cells {
-            cell_verts: VertexNumbers::XML {
-                connectivity: lines
-                    .iter()
-                    .flat_map(|&[a, b]| [u64::from(a), u64::from(b)])
-                    .collect(),
-                offsets: (1..=lines.len() as u64).map(|k| 2 * k).collect(),
-            },
-            types: vec![CellType::Line; lines.len()],
-        }
-    };
-    let point = attributes(path, "point", point_fields, n)?;
-    let cell = attributes(path, "cell", cell_fields, cells.num_cells())?;
-    let data = DataSet::inline(UnstructuredGridPiece {
-        points: points
-            .iter()
-            .flat_map(|&[x, y]| [x, y, 0.0])
-            .collect::<Vec<f64>>()
-            .into(),
-        cells,
-        data: Attributes { point, cell },
-    });
-    if n > 0 {
-        return write_xml(path, new_vtk(data));
-    }
-    // vtkio leaves out `NumberOfPoints="0" NumberOfCells="0"` (it skips zero attributes), and
-    // VTK then refuses the file ("returned failure for request: REQUEST_INFORMATION"). An
-    // empty frame is legitimate (no grains left, say), so put the attributes back.
-    let mut xml = Vec::new();
-    new_vtk(data)
-        .write_xml(&mut xml)
-        .map_err(|e| Error::Other(format!("{}: VTK XML writer: {e}", path.display())))?;
-    let xml = String::from_utf8(xml)
-        .map_err(|e| Error::Other(format!("{}: VTK XML writer: {e}", path.display())))?;
-    if !xml.contains("<Piece>") {
+    if let Some((k, l)) = lines
+        .iter()
+        .enumerate()
+        .find(|(_, l)| l.iter().any(|&p| p as usize >= n))
+    {
         return Err(Error::Other(format!(
-            "{}: unexpected VTK XML for an empty point set",
-            path.display()
+            "{}: line {k} joins points {} and {}, but there are only {n} points",
+            path.display(),
+            l[0],
+            l[1]
         )));
     }
-    let xml = xml.replacen(
-        "<Piece>",
-        r#"<Piece NumberOfPoints="0" NumberOfCells="0">"#,
-        1,
+    let (connectivity, per_cell, cell_type): (Vec<i64>, i64, u8) = if lines.is_empty() {
+        ((0..n as i64).collect(), 1, VTK_VERTEX)
+    } else {
+        let ends = lines
+            .iter()
+            .flat_map(|&[a, b]| [i64::from(a), i64::from(b)]);
+        (ends.collect(), 2, VTK_LINE)
+    };
+    let ncells = connectivity.len() / per_cell as usize;
+    check_fields(path, "point", point_fields, n)?;
+    check_fields(path, "cell", cell_fields, ncells)?;
+    let mut body = Body::new(*format, UNSTRUCTURED, "");
+    body.tag(
+        2,
+        &format!("<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{ncells}\">"),
     );
-    super::write_atomic_bytes(path, xml.as_bytes())
+    write_fields(&mut body, "PointData", point_fields);
+    write_fields(&mut body, "CellData", cell_fields);
+    body.tag(3, "<Points>");
+    let coords = points.iter().flat_map(|&[x, y]| [x, y, 0.0]).collect();
+    body.array(4, "Points", 3, Values::Real(coords));
+    body.tag(3, "</Points>");
+    body.tag(3, "<Cells>");
+    body.array(4, "connectivity", 1, Values::Int64(connectivity));
+    let offsets = (1..=ncells as i64).map(|k| per_cell * k).collect();
+    body.array(4, "offsets", 1, Values::Int64(offsets));
+    body.array(4, "types", 1, Values::UInt8(vec![cell_type; ncells]));
+    body.tag(3, "</Cells>");
+    body.tag(2, "</Piece>");
+    write_body(path, UNSTRUCTURED, body)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    const F: VtkFormat = VtkFormat {
+        compression: Compression::Zlib,
+        precision: Precision::F64,
+    };
 
     fn grid() -> ImageGrid {
         ImageGrid {
@@ -384,6 +318,7 @@ mod tests {
             &path,
             &grid(),
             &[Field::scalar("rho", &rho), Field::vector("velocity", &u)],
+            &F,
         )
         .unwrap_err();
         match err {
@@ -401,16 +336,17 @@ mod tests {
         assert!(write_vti(
             &path,
             &grid(),
-            &[Field::scalar("rho", &rho), Field::scalar("rho", &rho)]
+            &[Field::scalar("rho", &rho), Field::scalar("rho", &rho)],
+            &F
         )
         .is_err());
         let empty = ImageGrid { nx: 0, ..grid() };
-        assert!(write_vti(&path, &empty, &[]).is_err());
+        assert!(write_vti(&path, &empty, &[], &F).is_err());
         let flat = ImageGrid {
             spacing: [0.0, 1.0],
             ..grid()
         };
-        assert!(write_vti(&path, &flat, &[]).is_err());
+        assert!(write_vti(&path, &flat, &[], &F).is_err());
     }
 
     #[test]
@@ -418,13 +354,20 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("c.vtu");
         let pts = [[0.0, 0.0], [1.0, 0.0]];
-        assert!(write_vtu_points(&path, &pts, &[], &[[0, 2]], &[]).is_err());
+        assert!(write_vtu_points(&path, &pts, &[], &[[0, 2]], &[], &F).is_err());
         let f = [1.0, 2.0];
         // Two lines' worth of values for one line.
-        let err = write_vtu_points(&path, &pts, &[], &[[0, 1]], &[Field::scalar("force", &f)])
-            .unwrap_err();
+        let err = write_vtu_points(
+            &path,
+            &pts,
+            &[],
+            &[[0, 1]],
+            &[Field::scalar("force", &f)],
+            &F,
+        )
+        .unwrap_err();
         assert!(matches!(err, Error::Other(ref m) if m.contains("`force`")));
         // Without lines the cells are the points, so the same field fits.
-        write_vtu_points(&path, &pts, &[], &[], &[Field::scalar("force", &f)]).unwrap();
+        write_vtu_points(&path, &pts, &[], &[], &[Field::scalar("force", &f)], &F).unwrap();
     }
 }

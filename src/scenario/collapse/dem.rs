@@ -37,7 +37,7 @@ use crate::dem::packing::deposit_column;
 use crate::dem::stress::grain_stress;
 use crate::dem::{Dem, Energy, Wall};
 use crate::exec::Progress;
-use crate::io::{write_vtu_points, Field, PvdSeries};
+use crate::io::{write_vtu_points, Field, PvdSeries, VtkFormat};
 use crate::scenario::checkpointing::Control;
 use crate::scenario::dem::spec::{DemScenario, DemTimeSpec};
 use crate::scenario::Kind;
@@ -173,14 +173,14 @@ pub fn shape(dem: &Dem) -> Shape {
     }
 }
 
-/// Write frame `k` (grains as part 0, contacts as part 1) and list it in `pvd` at `time`.
+/// Write frame `k` at `time` (grains as part 0, contacts as part 1) into `dir` and list it in
+/// `pvd`.
 pub fn write_frame(
     dem: &Dem,
     s: &Shape,
     thickness: f64,
-    dir: &Path,
-    k: usize,
-    time: f64,
+    (format, dir): (&VtkFormat, &Path),
+    (k, time): (usize, f64),
     pvd: &mut PvdSeries,
 ) -> Result<()> {
     let g = &dem.grains;
@@ -203,6 +203,7 @@ pub fn write_frame(
         ],
         &[],
         &[],
+        format,
     )?;
     let (mut lines, mut f_n, mut f_t, mut wall) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let pl = dem.pairs();
@@ -236,7 +237,7 @@ pub fn write_frame(
         Field::scalar("wall", &wall),
     ];
     let cells: &[Field] = if lines.is_empty() { &[] } else { &fields };
-    write_vtu_points(&dir.join(&cname), &points, &[], &lines, cells)?;
+    write_vtu_points(&dir.join(&cname), &points, &[], &lines, cells, format)?;
     pvd.add(time, 0, &gname)?;
     pvd.add(time, 1, &cname)
 }
@@ -276,13 +277,15 @@ pub(super) fn energy_values(e: &Energy) -> [f64; 7] {
 }
 
 /// The plan of a DEM column (dry or submerged) of initial width `l_i`, deposited height `h_i`
-/// and initial potential energy `potential`, on the schedule of the scenario's `[time]`.
+/// and initial potential energy `potential`, on the schedule of the scenario's `[time]`, its
+/// frames written in `vtk`.
 pub(super) fn plan<'a>(
     scenario_name: &'a str,
     [l_i, h_i]: [f64; 2],
     gravity: f64,
     potential: f64,
     ts: &DemTimeSpec,
+    vtk: VtkFormat,
 ) -> Plan<'a> {
     Plan {
         name: scenario_name,
@@ -295,6 +298,7 @@ pub(super) fn plan<'a>(
         end_tc: ts.end_tc,
         rest_kinetic_fraction: ts.rest_kinetic_fraction,
         rest_duration_tc: ts.rest_duration_tc,
+        vtk,
     }
 }
 
@@ -357,12 +361,20 @@ impl Column for DemColumn {
     fn write_frame(
         &self,
         s: &DemShape,
+        format: &VtkFormat,
         dir: &Path,
         k: usize,
         t: f64,
         pvd: &mut PvdSeries,
     ) -> Result<()> {
-        write_frame(&self.dem, &s.shape, self.thickness, dir, k, t, pvd)
+        write_frame(
+            &self.dem,
+            &s.shape,
+            self.thickness,
+            (format, dir),
+            (k, t),
+            pvd,
+        )
     }
     fn advance(&mut self) -> Result<()> {
         let dt = self.dem.dt();
@@ -408,6 +420,7 @@ pub fn column(scenario: &DemScenario) -> Result<(DemColumn, Plan<'_>)> {
         scenario.gravity,
         e0.potential,
         ts,
+        scenario.vtk,
     );
     let series_steps = steps_per_row(ts.series_interval_tc, plan.tau_c(), dem.dt());
     let column = DemColumn {
@@ -446,6 +459,7 @@ pub fn run_resumable_collapse(
             scenario.gravity,
             potential,
             &scenario.time,
+            scenario.vtk,
         )
     };
     let start = || column(scenario);

@@ -27,7 +27,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::analysis::runout::{CollapseOutcome, CollapseRecord, EnergyBudget};
 use crate::exec::Progress;
-use crate::io::{write_json, CsvWriter, PvdEntry, PvdSeries};
+use crate::io::{write_json, CsvWriter, PvdEntry, PvdSeries, VtkFormat};
 use crate::scenario::checkpointing::Control;
 use crate::scenario::Kind;
 use crate::Result;
@@ -75,10 +75,12 @@ pub trait Column {
     fn time(&self) -> f64;
     /// Measure the state now: its time-series row and what a frame of it needs.
     fn measure(&mut self) -> Result<(Row, Self::Shape)>;
-    /// Write frame `k` of the state measured as `shape` at time `t` into `dir`, listed in `pvd`.
+    /// Write frame `k` of the state measured as `shape` at time `t` into `dir` in the VTK
+    /// `format`, listed in `pvd`.
     fn write_frame(
         &self,
         shape: &Self::Shape,
+        format: &VtkFormat,
         dir: &Path,
         k: usize,
         t: f64,
@@ -115,6 +117,8 @@ pub struct Plan<'a> {
     pub rest_kinetic_fraction: f64,
     /// … for this long (τ_c).
     pub rest_duration_tc: f64,
+    /// How the frames are written (the scenario's `[vtk]`).
+    pub vtk: VtkFormat,
 }
 
 impl Plan<'_> {
@@ -260,7 +264,7 @@ fn run_loop<C: Column>(
             values.extend_from_slice(&r.values);
             csv.row(&values)?;
             if b.row % frame_every == 0 {
-                column.write_frame(&shape, out_dir, b.frame, t, &mut pvd)?;
+                column.write_frame(&shape, &plan.vtk, out_dir, b.frame, t, &mut pvd)?;
                 b.frame += 1;
             }
             b.row += 1;
@@ -292,7 +296,7 @@ fn run_loop<C: Column>(
                     // number when one is due.
                     let (_, shape) = column.measure()?;
                     let t = column.time();
-                    column.write_frame(&shape, out_dir, b.frame, t, &mut pvd)?;
+                    column.write_frame(&shape, &plan.vtk, out_dir, b.frame, t, &mut pvd)?;
                     return Err(hooks.control.interrupted(signal, b.row, t, path, out_dir));
                 }
             }
@@ -309,7 +313,7 @@ fn run_loop<C: Column>(
     let wall_time_s = b.wall_time_s + t_run.elapsed().as_secs_f64();
     let t_end = column.time();
     if (b.row - 1) % frame_every != 0 {
-        column.write_frame(&last, out_dir, b.frame, t_end, &mut pvd)?;
+        column.write_frame(&last, &plan.vtk, out_dir, b.frame, t_end, &mut pvd)?;
     }
     let tally = column.tally(&last);
     let collapse = CollapseOutcome::from(CollapseRecord {

@@ -33,7 +33,7 @@ use crate::analysis::runout::CollapseOutcome;
 use crate::coupling::RveMaterial;
 use crate::dem::periodic_cell::PeriodicCell;
 use crate::exec::Progress;
-use crate::io::{write_vti, write_vtu_points, Field, ImageGrid, PvdSeries};
+use crate::io::{write_vti, write_vtu_points, Field, ImageGrid, PvdSeries, VtkFormat};
 use crate::mpm::material::{invariants, Material, MaterialModel, MaterialState};
 use crate::mpm::solver::{Mpm, MpmEnergy};
 use crate::scenario::checkpointing::Control;
@@ -50,7 +50,12 @@ pub trait PointOutput: Material + Clone + 'static {
     const SOLVER: &'static str;
     /// Write the grains of one point's state as VTK points centred on `centre` (only
     /// materials whose points hold grains can).
-    fn write_grains(state: &Self::State, centre: [f64; 2], path: &Path) -> Result<()>;
+    fn write_grains(
+        state: &Self::State,
+        centre: [f64; 2],
+        format: &VtkFormat,
+        path: &Path,
+    ) -> Result<()>;
 }
 
 impl PointOutput for MaterialModel {
@@ -61,7 +66,7 @@ impl PointOutput for MaterialModel {
         )]
     }
     const SOLVER: &'static str = "mpm";
-    fn write_grains(_: &MaterialState, _: [f64; 2], path: &Path) -> Result<()> {
+    fn write_grains(_: &MaterialState, _: [f64; 2], _: &VtkFormat, path: &Path) -> Result<()> {
         Err(Error::Other(format!(
             "{}: a continuum point holds no grains",
             path.display()
@@ -87,7 +92,12 @@ impl PointOutput for RveMaterial {
     /// The volume's grains at their places in the cell, the cell's centre H (½, ½) moved to
     /// `centre`, with their `radius` and `fluctuation_velocity` (the velocity less the
     /// affine part L x).
-    fn write_grains(cell: &PeriodicCell, centre: [f64; 2], path: &Path) -> Result<()> {
+    fn write_grains(
+        cell: &PeriodicCell,
+        centre: [f64; 2],
+        format: &VtkFormat,
+        path: &Path,
+    ) -> Result<()> {
         let mid = cell.cell() * nalgebra::Vector2::new(0.5, 0.5);
         let (pos, radius): (Vec<[f64; 2]>, Vec<f64>) = cell
             .grains()
@@ -98,7 +108,7 @@ impl PointOutput for RveMaterial {
             Field::scalar("radius", &radius),
             Field::vector("fluctuation_velocity", &vel),
         ];
-        write_vtu_points(path, &pos, &fields, &[], &[])
+        write_vtu_points(path, &pos, &fields, &[], &[], format)
     }
 }
 
@@ -219,6 +229,7 @@ pub fn shape<M: Material>(mpm: &Mpm<M>) -> Shape {
 fn write_frame<M: PointOutput>(
     mpm: &Mpm<M>,
     volumes: &[[f64; 2]],
+    format: &VtkFormat,
     dir: &Path,
     k: usize,
     pvd: &mut PvdSeries,
@@ -230,7 +241,7 @@ fn write_frame<M: PointOutput>(
             continue;
         };
         let name = format!("volume_{v}_{k:06}.vtu");
-        M::write_grains(&p.state[q], p.pos[q], &dir.join(&name))?;
+        M::write_grains(&p.state[q], p.pos[q], format, &dir.join(&name))?;
         pvd.add(mpm.time(), 2 + v, &name)?;
     }
     let n = p.len();
@@ -252,7 +263,7 @@ fn write_frame<M: PointOutput>(
     ];
     fields.extend(own.iter().map(|(n, v)| Field::scalar(n, v)));
     fields.push(Field::scalar("volume", &p.vol));
-    write_vtu_points(&dir.join(&name), &p.pos, &fields, &[], &[])?;
+    write_vtu_points(&dir.join(&name), &p.pos, &fields, &[], &[], format)?;
     let g = &mpm.grid;
     let mut rho = vec![0.0; g.nx * g.ny];
     let mut mv = vec![[0.0; 2]; g.nx * g.ny];
@@ -295,6 +306,7 @@ fn write_frame<M: PointOutput>(
             Field::scalar("density", &rho),
             Field::vector("velocity", &vel),
         ],
+        format,
     )?;
     pvd.add(mpm.time(), 0, &name)?;
     pvd.add(mpm.time(), 1, &gname)
@@ -390,12 +402,13 @@ impl<M: PointOutput> Column for MpmColumn<M> {
     fn write_frame(
         &self,
         _: &MpmEnergy,
+        format: &VtkFormat,
         dir: &Path,
         k: usize,
         _: f64,
         pvd: &mut PvdSeries,
     ) -> Result<()> {
-        write_frame(&self.mpm, &self.volumes, dir, k, pvd)
+        write_frame(&self.mpm, &self.volumes, format, dir, k, pvd)
     }
     fn advance(&mut self) -> Result<()> {
         self.mpm.steps(self.series_steps)
@@ -439,6 +452,7 @@ fn plan(scenario: &MpmScenario, height: f64, potential: f64) -> Plan<'_> {
         end_tc: ts.end_tc,
         rest_kinetic_fraction: ts.rest_kinetic_fraction,
         rest_duration_tc: ts.rest_duration_tc,
+        vtk: scenario.vtk,
     }
 }
 

@@ -47,7 +47,7 @@ use crate::dem::packing::deposit_column;
 use crate::dem::scale::GrainView;
 use crate::dem::{Dem, Energy, ExternalLoads, Wall};
 use crate::exec::Progress;
-use crate::io::{write_vti, Field, ImageGrid, PvdSeries};
+use crate::io::{write_vti, Field, ImageGrid, PvdSeries, VtkFormat};
 use crate::lbm::{Edges, Fluid, FluidModel, Lattice, Lbm, Macroscopic, Obstacles, Real, STOP_MACH};
 use crate::scale::Scale;
 use crate::scenario::checkpointing::Control;
@@ -260,7 +260,14 @@ impl FluidFields {
             * thickness
     }
 
-    fn write(&self, u: &crate::units::Units, hydro: f64, depth: f64, path: &Path) -> Result<()> {
+    fn write(
+        &self,
+        u: &crate::units::Units,
+        hydro: f64,
+        depth: f64,
+        format: &VtkFormat,
+        path: &Path,
+    ) -> Result<()> {
         let (nx, ny) = (self.m.nx, self.m.ny);
         let v = u.velocity_to_si(1.0);
         let vel: Vec<[f64; 2]> = (0..nx * ny)
@@ -291,6 +298,7 @@ impl FluidFields {
                 Field::scalar("vorticity", &vort),
                 Field::scalar("solid_fraction", &self.eps),
             ],
+            format,
         )
     }
 }
@@ -376,17 +384,30 @@ impl<T: Real> Column for SubmergedColumn<'_, T> {
     fn write_frame(
         &self,
         s: &Shape,
+        format: &VtkFormat,
         dir: &Path,
         k: usize,
         t: f64,
         pvd: &mut PvdSeries,
     ) -> Result<()> {
         let sc = self.scenario;
-        write_frame(&self.coupled.solid, s, sc.grains.thickness, dir, k, t, pvd)?;
+        write_frame(
+            &self.coupled.solid,
+            s,
+            sc.grains.thickness,
+            (format, dir),
+            (k, t),
+            pvd,
+        )?;
         let name = format!("fluid_{k:06}.vti");
         let hydro = sc.fluid.density * sc.gravity;
-        self.fields
-            .write(&self.derived.units, hydro, sc.fluid.depth, &dir.join(&name))?;
+        self.fields.write(
+            &self.derived.units,
+            hydro,
+            sc.fluid.depth,
+            format,
+            &dir.join(&name),
+        )?;
         pvd.add(t, 2, &name)
     }
     fn advance(&mut self) -> Result<()> {
@@ -503,6 +524,7 @@ fn submerged_plan(scenario: &SubmergedScenario, h_i: f64, potential: f64) -> Pla
         scenario.gravity,
         potential,
         &scenario.time,
+        scenario.vtk,
     )
 }
 

@@ -22,6 +22,7 @@ use serde::{Deserialize, Serialize};
 use crate::dem::contact::ContactParams;
 use crate::dem::packing::{ColumnSpec, SizeDistribution};
 use crate::dem::{DemParams, TimeStep};
+use crate::io::VtkFormat;
 use crate::scenario::{non_negative, positive, Kind, ScenarioFile};
 use crate::{Error, Result};
 
@@ -51,6 +52,9 @@ pub struct DemScenario {
     pub deposition: DepositionSpec,
     /// Time step, output intervals, stop criterion.
     pub time: DemTimeSpec,
+    /// How VTK frames are written (`[vtk]`, optional: zlib-compressed, f64, if absent).
+    #[serde(default)]
+    pub vtk: VtkFormat,
 }
 
 /// Grain sizes and material.

@@ -20,7 +20,9 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::analysis::spectrum::dominant_frequency;
-use crate::io::{write_json, write_vti, CsvWriter, Field, ImageGrid, PvdEntry, PvdSeries};
+use crate::io::{
+    write_json, write_vti, CsvWriter, Field, ImageGrid, PvdEntry, PvdSeries, VtkFormat,
+};
 use crate::lbm::{Fluid, LbmState, Macroscopic, STOP_MACH};
 use crate::scenario::checkpointing::Control;
 use crate::scenario::fluid::{Derived, Scenario};
@@ -262,6 +264,7 @@ struct Outputs {
     pvd: PvdSeries,
     probes: Vec<usize>,
     frames: usize,
+    vtk: VtkFormat,
 }
 
 impl Outputs {
@@ -315,6 +318,7 @@ impl Outputs {
                 .map(|p| scenario.cell_at(derived, p.position))
                 .collect(),
             frames,
+            vtk: scenario.vtk,
         }
     }
 
@@ -414,6 +418,7 @@ impl Outputs {
                 Field::scalar("vorticity", &vorticity),
                 Field::scalar("solid", &solid),
             ],
+            &self.vtk,
         )?;
         self.pvd.add(t, 0, &file)?;
         self.frames += 1;

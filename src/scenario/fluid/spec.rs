@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::io::VtkFormat;
 use crate::lbm::{CollisionModel, Edge, Edges, FluidModel, LbmSetup, MrtRates, Obstacle, Shape};
 use crate::scenario::{lattice_units, positive, Kind, ScenarioFile};
 use crate::units::{Units, CS2};
@@ -39,6 +40,9 @@ pub struct Scenario {
     /// Pressure/velocity probes written to the time series (none if absent).
     #[serde(default)]
     pub probes: Vec<ProbeSpec>,
+    /// How VTK frames are written (`[vtk]`, optional: zlib-compressed, f64, if absent).
+    #[serde(default)]
+    pub vtk: VtkFormat,
 }
 
 impl ScenarioFile for Scenario {

@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::dem::periodic_cell::Preparation;
 use crate::dem::{DemParams, TimeStep};
+use crate::io::VtkFormat;
 use crate::mpm::boundary::{Side, Wall, WallKind};
 use crate::mpm::grid::Grid;
 use crate::mpm::material::{LinearElastic, MaterialModel, MohrCoulomb, MuIMohrCoulomb};
@@ -51,6 +52,9 @@ pub struct MpmScenario {
     pub walls: WallsSpec,
     /// Time step, outputs, stop.
     pub time: MpmTimeSpec,
+    /// How VTK frames are written (`[vtk]`, optional: zlib-compressed, f64, if absent).
+    #[serde(default)]
+    pub vtk: VtkFormat,
 }
 
 /// Constitutive law, chosen by `model`.

@@ -23,6 +23,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::io::VtkFormat;
 use crate::scale::substeps;
 use crate::scenario::dem::{
     ColumnGeometry, ContactSpec, DemScenario, DemTimeSpec, DepositionSpec, DerivedDem, GrainsSpec,
@@ -62,6 +63,9 @@ pub struct SubmergedScenario {
     pub fluid: LiquidSpec,
     /// Fluid–grain coupling and lattice.
     pub coupling: CouplingSpec,
+    /// How VTK frames are written (`[vtk]`, optional: zlib-compressed, f64, if absent).
+    #[serde(default)]
+    pub vtk: VtkFormat,
 }
 
 /// The liquid filling the tank.
@@ -164,6 +168,7 @@ impl SubmergedScenario {
             wall_contact: self.wall_contact,
             deposition: self.deposition.clone(),
             time: self.time.clone(),
+            vtk: self.vtk,
         }
     }
 

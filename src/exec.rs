@@ -1,6 +1,8 @@
 //! Execution helpers shared by the solvers and the runners: progress callbacks, thread pools,
 //! the median of timed repeats and the memory a run may take.
 
+pub mod simd;
+
 use crate::{Error, Result};
 
 /// Progress callback: (work done, work total), in whatever unit the caller reports (steps,

@@ -418,6 +418,7 @@ impl<T: Real> Lattice<T> {
         let specials = &self.specials;
         let wall_corr = &self.wall_corr;
         let bulk = bulk_kernel_for::<T>();
+        let special = special_kernel_for::<T>();
         self.rows.par_iter().enumerate().for_each(|(y, plan)| {
             let (runs, group_list) = if even {
                 (&plan.even_runs, &plan.even_specials)
@@ -434,7 +435,7 @@ impl<T: Real> Lattice<T> {
             for group in group_list.chunks(LANES) {
                 // SAFETY: as above; special nodes touch only their own link slots.
                 unsafe {
-                    special_nodes(
+                    special(
                         base.get(),
                         n,
                         specials,
@@ -497,6 +498,8 @@ impl<T: Real> Lattice<T> {
         let wall_corr = &self.wall_corr;
         let row_start = &self.covered_rows;
         let bulk_fn = bulk_kernel_for::<T>();
+        let psm_kernel = psm_kernel_for::<T, C>();
+        let special = special_kernel_for::<T>();
         self.rows.par_iter().enumerate().for_each(|(y, plan)| {
             let (runs, group_list) = if even {
                 (&plan.even_runs, &plan.even_specials)
@@ -539,7 +542,7 @@ impl<T: Real> Lattice<T> {
                 if len == LANES {
                     // SAFETY: as in `step`.
                     unsafe {
-                        special_nodes(
+                        special(
                             base.get(),
                             n,
                             specials,
@@ -556,7 +559,7 @@ impl<T: Real> Lattice<T> {
             if len > 0 {
                 // SAFETY: as in `step`.
                 unsafe {
-                    special_nodes(
+                    special(
                         base.get(),
                         n,
                         specials,
@@ -588,7 +591,7 @@ impl<T: Real> Lattice<T> {
                 let x0 = c - y * nx;
                 // SAFETY: as in `step`; entries k..e of `exchange` belong to this row.
                 unsafe {
-                    bulk_run_psm::<T, C, PSM_LANES>(
+                    psm_kernel(
                         base.get(),
                         n,
                         nx,
@@ -809,6 +812,7 @@ impl<T: Real> Lattice<T> {
 /// # Safety
 /// As [`super::simd::bulk_run`]; entries `k0..k0 + x1 − x0` of `exchange` belong to this call.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 unsafe fn bulk_run_psm<T: Real, C: CoveredCells<T>, const L: usize>(
     f: *mut T,
     n: usize,
@@ -867,6 +871,68 @@ unsafe fn bulk_run_psm<T: Real, C: CoveredCells<T>, const L: usize>(
     }
 }
 
+/// Stamps out `$name`, a `#[target_feature]` copy for the level `avx512` or `avx2`
+/// ([`super::simd::Level`]) of the `#[inline(always)]` kernel `$kernel` (generic over `$g`,
+/// called as `$kernel::<$k…>`).
+///
+/// # Safety (of the copy)
+/// As the kernel's; the CPU has the features ([`super::simd::level`]).
+macro_rules! with_features {
+    ($name:ident, avx512, $($rest:tt)*) => {
+        with_features!(@ $name, "avx512f,avx512bw,avx512dq,avx512vl,avx2,fma", $($rest)*);
+    };
+    ($name:ident, avx2, $($rest:tt)*) => {
+        with_features!(@ $name, "avx2,fma", $($rest)*);
+    };
+    (@ $name:ident, $features:literal, $kernel:ident::<$($k:tt),*>, <$($g:ident: $b:path),*>,
+     ($($a:ident: $t:ty),* $(,)?)) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $features)]
+        #[allow(clippy::too_many_arguments)]
+        unsafe fn $name<$($g: $b),*>($($a: $t),*) {
+            // SAFETY: forwarded from the caller.
+            unsafe { $kernel::<$($k),*>($($a),*) }
+        }
+    };
+}
+
+/// Signature of [`bulk_run_psm`].
+type PsmFn<T, C> = unsafe fn(
+    *mut T,
+    usize,
+    usize,
+    usize,
+    usize,
+    usize,
+    usize,
+    bool,
+    &Collider<T>,
+    &C,
+    usize,
+    *mut [f64; 2],
+);
+
+/// [`bulk_run_psm`] at [`PSM_LANES`], compiled for this CPU's vector extensions (as the plain
+/// bulk loop, [`super::simd`]): without it the covered stretches of a coupled step ran the
+/// baseline's scalar `mul_add` library calls.
+fn psm_kernel_for<T: Real, C: CoveredCells<T>>() -> PsmFn<T, C> {
+    use super::simd::Level;
+    match super::simd::level() {
+        #[cfg(target_arch = "x86_64")]
+        Level::Avx512 => psm_avx512::<T, C>,
+        #[cfg(target_arch = "x86_64")]
+        Level::Avx2 => psm_avx2::<T, C>,
+        _ => bulk_run_psm::<T, C, PSM_LANES>,
+    }
+}
+
+with_features!(psm_avx512, avx512, bulk_run_psm::<T, C, PSM_LANES>, <T: Real, C: CoveredCells<T>>,
+    (f: *mut T, n: usize, nx: usize, ny: usize, y: usize, x0: usize, x1: usize, even: bool,
+     collider: &Collider<T>, psm: &C, k0: usize, exchange: *mut [f64; 2]));
+with_features!(psm_avx2, avx2, bulk_run_psm::<T, C, PSM_LANES>, <T: Real, C: CoveredCells<T>>,
+    (f: *mut T, n: usize, nx: usize, ny: usize, y: usize, x0: usize, x1: usize, even: bool,
+     collider: &Collider<T>, psm: &C, k0: usize, exchange: *mut [f64; 2]));
+
 /// Gather the pre-collision populations of a special node and the mask of unknown ones, and
 /// apply the Zou–He closure.
 ///
@@ -914,11 +980,36 @@ unsafe fn gather<T: Real>(
     (g, unknown)
 }
 
+/// Signature of [`special_nodes`].
+type SpecialFn<T> =
+    unsafe fn(*mut T, usize, &[Special], &[u32], bool, &Collider<T>, &[[T; Q]], [f64; 2]);
+
+/// [`special_nodes`] compiled for this CPU's vector extensions: in the baseline its `mul_add`
+/// calls are library calls, which cost a periodic 2048² box 5–10 % of its step.
+fn special_kernel_for<T: Real>() -> SpecialFn<T> {
+    use super::simd::Level;
+    match super::simd::level() {
+        #[cfg(target_arch = "x86_64")]
+        Level::Avx512 => special_avx512::<T>,
+        #[cfg(target_arch = "x86_64")]
+        Level::Avx2 => special_avx2::<T>,
+        _ => special_nodes::<T>,
+    }
+}
+
+with_features!(special_avx512, avx512, special_nodes::<T>, <T: Real>,
+    (f: *mut T, n: usize, specials: &[Special], group: &[u32], even: bool,
+     collider: &Collider<T>, wall_corr: &[[T; Q]], zh_shift: [f64; 2]));
+with_features!(special_avx2, avx2, special_nodes::<T>, <T: Real>,
+    (f: *mut T, n: usize, specials: &[Special], group: &[u32], even: bool,
+     collider: &Collider<T>, wall_corr: &[[T; Q]], zh_shift: [f64; 2]));
+
 /// Stream–collide a group of at most [`LANES`] special nodes of one row.
 ///
 /// # Safety
 /// As [`super::simd::bulk_run`]; `group` indexes `specials`.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 unsafe fn special_nodes<T: Real>(
     f: *mut T,
     n: usize,

@@ -13,6 +13,7 @@
 use super::collision::Collider;
 use super::d2q9::{CX, CY, OPP, Q};
 use super::real::Real;
+pub use crate::exec::simd::{level, Level};
 
 /// Collide one run of bulk nodes of row `y` (the AA pattern of [`super::lattice`]).
 ///
@@ -81,41 +82,6 @@ pub(super) unsafe fn bulk_run<T: Real, const L: usize>(
 /// step, collision.
 pub(super) type BulkFn<T> =
     unsafe fn(*mut T, usize, usize, usize, usize, usize, usize, bool, &Collider<T>);
-
-/// The widest vector extension this CPU has, among those the kernels are compiled for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Level {
-    /// AVX-512 (F, BW, DQ, VL) with FMA.
-    Avx512,
-    /// AVX2 with FMA.
-    Avx2,
-    /// The target's baseline (SSE2 on x86-64).
-    Baseline,
-}
-
-/// The level the kernels run at on this CPU (detected once).
-pub fn level() -> Level {
-    static LEVEL: std::sync::OnceLock<Level> = std::sync::OnceLock::new();
-    *LEVEL.get_or_init(detect)
-}
-
-#[cfg(target_arch = "x86_64")]
-fn detect() -> Level {
-    use std::arch::is_x86_feature_detected as has;
-    let avx2 = has!("avx2") && has!("fma");
-    if avx2 && has!("avx512f") && has!("avx512bw") && has!("avx512dq") && has!("avx512vl") {
-        Level::Avx512
-    } else if avx2 {
-        Level::Avx2
-    } else {
-        Level::Baseline
-    }
-}
-
-#[cfg(not(target_arch = "x86_64"))]
-fn detect() -> Level {
-    Level::Baseline
-}
 
 /// The bulk loop for this CPU's [`level`].
 pub(super) fn bulk_kernel<T: Real, const L: usize>() -> BulkFn<T> {

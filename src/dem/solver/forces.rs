@@ -93,165 +93,33 @@ impl Dem {
             cand: &mut self.cand[..nch],
             parts: &mut self.parts[..nch],
         };
-        let force_pass = |s: Span| {
-            let (c, a, len) = (s.c0, s.c0 * GRAIN_CHUNK, s.fx.len());
-            let (fx, fy, tq) = (s.fx, s.fy, s.tq);
-            let (ev, wev, queue) = (&mut s.events[0], &mut s.wevents[0], &mut s.queued[0]);
-            ev.clear();
-            wev.clear();
-            queue.clear();
-            let mut part = Part {
-                reach: c as u32,
-                ..Part::default()
-            };
-            // Gravity, global damping (predictor velocity) and external loads; their work
-            // over the step uses Δx = Δt v_½.
-            for k in 0..len {
-                let i = a + k;
-                fx[k] = m[i] * grav[0];
-                fy[k] = m[i] * grav[1];
-                tq[k] = 0.0;
-                if alpha != 0.0 {
-                    fx[k] -= alpha * m[i] * vxp[i];
-                    fy[k] -= alpha * m[i] * vyp[i];
-                    part.d_glob += alpha * m[i] * (vxp[i] * vx[i] + vyp[i] * vy[i]);
-                }
-                if !lx.is_empty() {
-                    fx[k] += lx[i];
-                    part.w_ext += lx[i] * vx[i];
-                }
-                if !ly.is_empty() {
-                    fy[k] += ly[i];
-                    part.w_ext += ly[i] * vy[i];
-                }
-                if !lt.is_empty() {
-                    tq[k] += lt[i];
-                    part.w_ext += lt[i] * om[i];
-                }
-            }
-            let (state, flags) = (s.state, s.flags);
-            let (p0, end) = (s.p0, a + len);
-            let (ci, cj) = (&pi[p0..p0 + state.len()], &pj[p0..p0 + state.len()]);
-            // Most pairs of a Verlet list are apart now and were apart at the last
-            // evaluation: skip them in a tight first pass.
-            let cand = candidates(ci, cj, flags, x, y, rad, &mut s.cand[0]);
-            for &k in cand {
-                let k = k as usize;
-                let (i, j) = (ci[k] as usize, cj[k] as usize);
-                let (dx, dy) = (x[j] - x[i], y[j] - y[i]);
-                let (ri, rj) = (rad[i], rad[j]);
-                let d2 = dx * dx + dy * dy;
-                let rs = ri + rj;
-                let d = d2.sqrt();
-                let (nx, ny) = if d > 0.0 {
-                    (dx / d, dy / d)
-                } else {
-                    (1.0, 0.0)
-                };
-                let (tx, ty) = (-ny, nx);
-                // Mid-step (current) and predictor relative velocities.
-                let (dvx, dvy) = (vx[i] - vx[j], vy[i] - vy[j]);
-                let (wi, wj) = (om[i], om[j]);
-                let (ex, ey) = (vxp[i] - vxp[j], vyp[i] - vyp[j]);
-                let (pwi, pwj) = (wp[i], wp[j]);
-                let (mi, mj) = (m[i], m[j]);
-                let motion = Motion {
-                    delta: rs - d,
-                    u: [dvx * nx + dvy * ny, ex * nx + ey * ny],
-                    v_t: [
-                        dvx * tx + dvy * ty + wi * ri + wj * rj,
-                        ex * tx + ey * ty + pwi * ri + pwj * rj,
-                    ],
-                    w: [wi - wj, pwi - pwj],
-                    m_eff: mi * mj / (mi + mj),
-                    r_eff: ri * rj / rs,
-                };
-                let r = law.resolve(&motion, &mut state[k], dt_hist);
-                flags[k] = if r.touching { PAIR_TOUCHING } else { 0 };
-                part.deepest = part.deepest.deeper(Overlap {
-                    relative: motion.delta / ri.min(rj),
-                    i: i as u32,
-                    j: j as u32,
-                });
-                let [an, at, ar] = r.apply;
-                let (f0, f1) = (-an * nx + at * tx, -an * ny + at * ty);
-                let li = i - a;
-                fx[li] += f0;
-                fy[li] += f1;
-                tq[li] += ri * at + ar;
-                if j < end {
-                    let lj = j - a;
-                    fx[lj] -= f0;
-                    fy[lj] -= f1;
-                    tq[lj] += rj * at - ar;
-                } else {
-                    queue.push(JForce {
-                        j: j as u32,
-                        f: [-f0, -f1, rj * at - ar],
-                    });
-                    part.reach = part.reach.max((j / GRAIN_CHUNK) as u32);
-                }
-                if r.event {
-                    let s = &state[k];
-                    let (dn, dt, dm) = (s.f_n - an, s.f_t - at, s.m_r - ar);
-                    ev.push(Event {
-                        i: i as u32,
-                        j: j as u32,
-                        d: [
-                            -dn * nx + dt * tx,
-                            -dn * ny + dt * ty,
-                            ri * dt + dm,
-                            rj * dt - dm,
-                        ],
-                    });
-                }
-                part = part.add(&r);
-            }
-            let (wstate, w0) = (s.wstate, s.w0);
-            for k in 0..wstate.len() {
-                let (i, wi) = (wg[w0 + k] as usize, ww[w0 + k] as usize);
-                let (dist, [nx, ny]) = walls[wi].distance([x[i], y[i]]);
-                let ri = rad[i];
-                if dist >= ri && !wstate[k].touching() {
-                    continue;
-                }
-                let (tx, ty) = (-ny, nx);
-                let (w, w1) = (om[i], wp[i]);
-                // Velocities relative to the wall (at rest unless it was set moving).
-                let [ux, uy] = wall_v.get(wi).copied().unwrap_or([0.0; 2]);
-                let (rx, ry, rxp, ryp) = (vx[i] - ux, vy[i] - uy, vxp[i] - ux, vyp[i] - uy);
-                let motion = Motion {
-                    delta: ri - dist,
-                    u: [rx * nx + ry * ny, rxp * nx + ryp * ny],
-                    v_t: [rx * tx + ry * ty + w * ri, rxp * tx + ryp * ty + w1 * ri],
-                    w: [w, w1],
-                    m_eff: m[i],
-                    r_eff: ri,
-                };
-                let r = wlaw.resolve(&motion, &mut wstate[k], dt_hist);
-                part.deepest = part.deepest.deeper(Overlap {
-                    relative: motion.delta / ri,
-                    i: i as u32,
-                    j: u32::MAX,
-                });
-                let [an, at, ar] = r.apply;
-                let li = i - a;
-                fx[li] += -an * nx + at * tx;
-                fy[li] += -an * ny + at * ty;
-                tq[li] += ri * at + ar;
-                if r.event {
-                    let st = &wstate[k];
-                    let (dn, dt, dm) = (st.f_n - an, st.f_t - at, st.m_r - ar);
-                    wev.push(Event {
-                        i: i as u32,
-                        j: u32::MAX,
-                        d: [-dn * nx + dt * tx, -dn * ny + dt * ty, ri * dt + dm, 0.0],
-                    });
-                }
-                part = part.add(&r);
-            }
-            s.parts[0] = part;
+        let inputs = ForceInputs {
+            x,
+            y,
+            vx,
+            vy,
+            om,
+            rad,
+            m,
+            vxp,
+            vyp,
+            wp,
+            law,
+            wlaw,
+            walls,
+            wall_v,
+            pi,
+            pj,
+            wg,
+            ww,
+            grav,
+            alpha,
+            lx,
+            ly,
+            lt,
+            dt_hist,
         };
+        let force_pass = |s: Span| force_chunk(s, &inputs);
         for_each_chunk(span, first, wfirst, &force_pass);
         let total = self.parts.iter().fold(Part::default(), |a, b| a.merge(b));
         // Which earlier chunks queued forces for each chunk.
@@ -552,6 +420,226 @@ fn for_each_chunk<F: Fn(Span) + Sync>(s: Span, first: &[u32], wfirst: &[u32], f:
                 || for_each_chunk(b, first, wfirst, f),
             );
         }
+    }
+}
+
+/// What the force pass reads: the grains' state, the contact laws and walls, the pair lists,
+/// the body forces and external loads, and the step over which springs advance.
+#[derive(Clone, Copy)]
+struct ForceInputs<'a> {
+    x: &'a [f64],
+    y: &'a [f64],
+    vx: &'a [f64],
+    vy: &'a [f64],
+    om: &'a [f64],
+    rad: &'a [f64],
+    m: &'a [f64],
+    vxp: &'a [f64],
+    vyp: &'a [f64],
+    wp: &'a [f64],
+    law: Law,
+    wlaw: Law,
+    walls: &'a [Wall],
+    wall_v: &'a [[f64; 2]],
+    pi: &'a [u32],
+    pj: &'a [u32],
+    wg: &'a [u32],
+    ww: &'a [u32],
+    grav: [f64; 2],
+    alpha: f64,
+    lx: &'a [f64],
+    ly: &'a [f64],
+    lt: &'a [f64],
+    dt_hist: f64,
+}
+
+crate::exec::simd::multiversion! {
+    /// The force pass of one chunk of grains (`s`), see [`Dem::compute_forces`]; compiled for
+    /// this CPU's vector extensions ([`crate::exec::simd`]).
+    fn force_chunk(s: Span<'_>, inputs: &ForceInputs<'_>) {
+        let ForceInputs {
+            x,
+            y,
+            vx,
+            vy,
+            om,
+            rad,
+            m,
+            vxp,
+            vyp,
+            wp,
+            law,
+            wlaw,
+            walls,
+            wall_v,
+            pi,
+            pj,
+            wg,
+            ww,
+            grav,
+            alpha,
+            lx,
+            ly,
+            lt,
+            dt_hist,
+        } = *inputs;
+        let (c, a, len) = (s.c0, s.c0 * GRAIN_CHUNK, s.fx.len());
+        let (fx, fy, tq) = (s.fx, s.fy, s.tq);
+        let (ev, wev, queue) = (&mut s.events[0], &mut s.wevents[0], &mut s.queued[0]);
+        ev.clear();
+        wev.clear();
+        queue.clear();
+        let mut part = Part {
+            reach: c as u32,
+            ..Part::default()
+        };
+        // Gravity, global damping (predictor velocity) and external loads; their work
+        // over the step uses Δx = Δt v_½.
+        for k in 0..len {
+            let i = a + k;
+            fx[k] = m[i] * grav[0];
+            fy[k] = m[i] * grav[1];
+            tq[k] = 0.0;
+            if alpha != 0.0 {
+                fx[k] -= alpha * m[i] * vxp[i];
+                fy[k] -= alpha * m[i] * vyp[i];
+                part.d_glob += alpha * m[i] * (vxp[i] * vx[i] + vyp[i] * vy[i]);
+            }
+            if !lx.is_empty() {
+                fx[k] += lx[i];
+                part.w_ext += lx[i] * vx[i];
+            }
+            if !ly.is_empty() {
+                fy[k] += ly[i];
+                part.w_ext += ly[i] * vy[i];
+            }
+            if !lt.is_empty() {
+                tq[k] += lt[i];
+                part.w_ext += lt[i] * om[i];
+            }
+        }
+        let (state, flags) = (s.state, s.flags);
+        let (p0, end) = (s.p0, a + len);
+        let (ci, cj) = (&pi[p0..p0 + state.len()], &pj[p0..p0 + state.len()]);
+        // Most pairs of a Verlet list are apart now and were apart at the last
+        // evaluation: skip them in a tight first pass.
+        let cand = candidates(ci, cj, flags, x, y, rad, &mut s.cand[0]);
+        for &k in cand {
+            let k = k as usize;
+            let (i, j) = (ci[k] as usize, cj[k] as usize);
+            let (dx, dy) = (x[j] - x[i], y[j] - y[i]);
+            let (ri, rj) = (rad[i], rad[j]);
+            let d2 = dx * dx + dy * dy;
+            let rs = ri + rj;
+            let d = d2.sqrt();
+            let (nx, ny) = if d > 0.0 {
+                (dx / d, dy / d)
+            } else {
+                (1.0, 0.0)
+            };
+            let (tx, ty) = (-ny, nx);
+            // Mid-step (current) and predictor relative velocities.
+            let (dvx, dvy) = (vx[i] - vx[j], vy[i] - vy[j]);
+            let (wi, wj) = (om[i], om[j]);
+            let (ex, ey) = (vxp[i] - vxp[j], vyp[i] - vyp[j]);
+            let (pwi, pwj) = (wp[i], wp[j]);
+            let (mi, mj) = (m[i], m[j]);
+            let motion = Motion {
+                delta: rs - d,
+                u: [dvx * nx + dvy * ny, ex * nx + ey * ny],
+                v_t: [
+                    dvx * tx + dvy * ty + wi * ri + wj * rj,
+                    ex * tx + ey * ty + pwi * ri + pwj * rj,
+                ],
+                w: [wi - wj, pwi - pwj],
+                m_eff: mi * mj / (mi + mj),
+                r_eff: ri * rj / rs,
+            };
+            let r = law.resolve(&motion, &mut state[k], dt_hist);
+            flags[k] = if r.touching { PAIR_TOUCHING } else { 0 };
+            part.deepest = part.deepest.deeper(Overlap {
+                relative: motion.delta / ri.min(rj),
+                i: i as u32,
+                j: j as u32,
+            });
+            let [an, at, ar] = r.apply;
+            let (f0, f1) = (-an * nx + at * tx, -an * ny + at * ty);
+            let li = i - a;
+            fx[li] += f0;
+            fy[li] += f1;
+            tq[li] += ri * at + ar;
+            if j < end {
+                let lj = j - a;
+                fx[lj] -= f0;
+                fy[lj] -= f1;
+                tq[lj] += rj * at - ar;
+            } else {
+                queue.push(JForce {
+                    j: j as u32,
+                    f: [-f0, -f1, rj * at - ar],
+                });
+                part.reach = part.reach.max((j / GRAIN_CHUNK) as u32);
+            }
+            if r.event {
+                let s = &state[k];
+                let (dn, dt, dm) = (s.f_n - an, s.f_t - at, s.m_r - ar);
+                ev.push(Event {
+                    i: i as u32,
+                    j: j as u32,
+                    d: [
+                        -dn * nx + dt * tx,
+                        -dn * ny + dt * ty,
+                        ri * dt + dm,
+                        rj * dt - dm,
+                    ],
+                });
+            }
+            part = part.add(&r);
+        }
+        let (wstate, w0) = (s.wstate, s.w0);
+        for k in 0..wstate.len() {
+            let (i, wi) = (wg[w0 + k] as usize, ww[w0 + k] as usize);
+            let (dist, [nx, ny]) = walls[wi].distance([x[i], y[i]]);
+            let ri = rad[i];
+            if dist >= ri && !wstate[k].touching() {
+                continue;
+            }
+            let (tx, ty) = (-ny, nx);
+            let (w, w1) = (om[i], wp[i]);
+            // Velocities relative to the wall (at rest unless it was set moving).
+            let [ux, uy] = wall_v.get(wi).copied().unwrap_or([0.0; 2]);
+            let (rx, ry, rxp, ryp) = (vx[i] - ux, vy[i] - uy, vxp[i] - ux, vyp[i] - uy);
+            let motion = Motion {
+                delta: ri - dist,
+                u: [rx * nx + ry * ny, rxp * nx + ryp * ny],
+                v_t: [rx * tx + ry * ty + w * ri, rxp * tx + ryp * ty + w1 * ri],
+                w: [w, w1],
+                m_eff: m[i],
+                r_eff: ri,
+            };
+            let r = wlaw.resolve(&motion, &mut wstate[k], dt_hist);
+            part.deepest = part.deepest.deeper(Overlap {
+                relative: motion.delta / ri,
+                i: i as u32,
+                j: u32::MAX,
+            });
+            let [an, at, ar] = r.apply;
+            let li = i - a;
+            fx[li] += -an * nx + at * tx;
+            fy[li] += -an * ny + at * ty;
+            tq[li] += ri * at + ar;
+            if r.event {
+                let st = &wstate[k];
+                let (dn, dt, dm) = (st.f_n - an, st.f_t - at, st.m_r - ar);
+                wev.push(Event {
+                    i: i as u32,
+                    j: u32::MAX,
+                    d: [-dn * nx + dt * tx, -dn * ny + dt * ty, ri * dt + dm, 0.0],
+                });
+            }
+            part = part.add(&r);
+        }
+        s.parts[0] = part;
     }
 }
 

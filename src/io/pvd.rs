@@ -6,7 +6,7 @@ use super::csv::format_f64;
 use crate::{Error, Result};
 
 /// Escapes the five XML special characters for use inside a double-quoted attribute value.
-fn xml_escape(s: &str) -> String {
+pub(super) fn xml_escape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {

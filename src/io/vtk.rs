@@ -11,7 +11,8 @@
 use std::collections::HashSet;
 use std::path::Path;
 
-use super::vtk_appended::{escape, Body, Values};
+use super::pvd::xml_escape;
+use super::vtk_appended::{Body, Values};
 pub use super::vtk_appended::{Compression, Precision, VtkFormat};
 use crate::{Error, Result};
 
@@ -136,7 +137,7 @@ fn write_fields(body: &mut Body, element: &str, fields: &[Field]) {
             )
         });
         if let Some(f) = first {
-            active.push_str(&format!(" {attr}=\"{}\"", escape(f.name)));
+            active.push_str(&format!(" {attr}=\"{}\"", xml_escape(f.name)));
         }
     }
     body.tag(3, &format!("<{element}{active}>"));

@@ -14,6 +14,8 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::pvd::xml_escape;
+
 /// How VTK frames are written: the `[vtk]` table of a scenario.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -110,7 +112,7 @@ impl Body {
         };
         let name = match name {
             "" => String::new(),
-            n => format!(" Name=\"{}\"", escape(n)),
+            n => format!(" Name=\"{}\"", xml_escape(n)),
         };
         let tag = format!(
             "<DataArray type=\"{ty}\"{name} NumberOfComponents=\"{ncomp}\" format=\"appended\" \
@@ -184,22 +186,6 @@ fn zlib(chunk: &[u8]) -> Vec<u8> {
     e.finish().expect("zlib into memory")
 }
 
-/// `s` with the five XML special characters escaped, for an attribute value.
-pub(super) fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c => out.push(c),
-        }
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -238,10 +224,5 @@ mod tests {
                 .sum();
             assert_eq!(b.data.len() as u64, 24 + 8 * n as u64 + sizes);
         }
-    }
-
-    #[test]
-    fn names_are_escaped() {
-        assert_eq!(escape(r#"a<b>&"c'"#), "a&lt;b&gt;&amp;&quot;c&apos;");
     }
 }

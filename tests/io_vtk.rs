@@ -431,3 +431,34 @@ fn vtk_itself_reads_every_format() {
         assert!(values(&v["points"]).is_empty());
     }
 }
+
+/// A scenario's `[vtk]` table is read in every kind; an unknown value or key is refused with
+/// the key named.
+#[test]
+fn vtk_table_is_read_and_checked() {
+    use granflow::scenario::fluid::Scenario;
+    use granflow::scenario::ScenarioFile;
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/lbm/cavity_re100.toml");
+    let base = std::fs::read_to_string(path).unwrap();
+    let with = |table: &str| Scenario::from_toml(&format!("{base}\n[vtk]\n{table}\n"));
+    assert_eq!(
+        Scenario::from_toml(&base).unwrap().vtk,
+        VtkFormat::default()
+    );
+    let s = with("compression = \"lz4\"\nprecision = \"f32\"").unwrap();
+    assert_eq!(
+        s.vtk,
+        VtkFormat {
+            compression: Compression::Lz4,
+            precision: Precision::F32
+        }
+    );
+    for (table, key) in [
+        ("compression = \"gzip\"", "compression"),
+        ("precision = \"f16\"", "precision"),
+        ("level = 9", "level"),
+    ] {
+        let err = with(table).unwrap_err().to_string();
+        assert!(err.contains(key), "{table}: {err}");
+    }
+}

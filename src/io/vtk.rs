@@ -12,7 +12,7 @@ use std::collections::HashSet;
 use std::path::Path;
 
 use super::pvd::xml_escape;
-use super::vtk_appended::{Body, Values};
+use super::vtk_appended::Body;
 pub use super::vtk_appended::{Compression, Precision, VtkFormat};
 use crate::{Error, Result};
 
@@ -142,17 +142,19 @@ fn write_fields(body: &mut Body, element: &str, fields: &[Field]) {
     }
     body.tag(3, &format!("<{element}{active}>"));
     for f in fields {
-        let (ncomp, values) = match f.data {
-            FieldData::Scalar(v) => (1, v.to_vec()),
-            FieldData::Vector(v) => (3, v.iter().flat_map(|&[x, y]| [x, y, 0.0]).collect()),
-            FieldData::Tensor(v) => (
-                9,
-                v.iter()
-                    .flat_map(|&[xx, xy, yx, yy]| [xx, xy, 0.0, yx, yy, 0.0, 0.0, 0.0, 0.0])
-                    .collect(),
-            ),
-        };
-        body.array(4, f.name, ncomp, Values::Real(values));
+        let (name, d) = (f.name, 4);
+        match f.data {
+            FieldData::Scalar(v) => body.reals(d, name, 1, v.iter().copied()),
+            FieldData::Vector(v) => {
+                body.reals(d, name, 3, v.iter().flat_map(|&[x, y]| [x, y, 0.0]));
+            }
+            FieldData::Tensor(v) => {
+                let t = v
+                    .iter()
+                    .flat_map(|&[xx, xy, yx, yy]| [xx, xy, 0.0, yx, yy, 0.0, 0.0, 0.0, 0.0]);
+                body.reals(d, name, 9, t);
+            }
+        }
     }
     body.tag(3, &format!("</{element}>"));
 }
@@ -278,14 +280,13 @@ pub fn write_vtu_points(
     write_fields(&mut body, "PointData", point_fields);
     write_fields(&mut body, "CellData", cell_fields);
     body.tag(3, "<Points>");
-    let coords = points.iter().flat_map(|&[x, y]| [x, y, 0.0]).collect();
-    body.array(4, "Points", 3, Values::Real(coords));
+    let coords = points.iter().flat_map(|&[x, y]| [x, y, 0.0]);
+    body.reals(4, "Points", 3, coords);
     body.tag(3, "</Points>");
     body.tag(3, "<Cells>");
-    body.array(4, "connectivity", 1, Values::Int64(connectivity));
-    let offsets = (1..=ncells as i64).map(|k| per_cell * k).collect();
-    body.array(4, "offsets", 1, Values::Int64(offsets));
-    body.array(4, "types", 1, Values::UInt8(vec![cell_type; ncells]));
+    body.int64s(4, "connectivity", connectivity.into_iter());
+    body.int64s(4, "offsets", (1..=ncells as i64).map(|k| per_cell * k));
+    body.uint8s(4, "types", vec![cell_type; ncells]);
     body.tag(3, "</Cells>");
     body.tag(2, "</Piece>");
     write_body(path, UNSTRUCTURED, body)

@@ -96,20 +96,39 @@ impl Body {
         self.xml.push('\n');
     }
 
-    /// Append a `DataArray` of `ncomp` components per tuple, `name` (may be empty: no
-    /// `Name`), whose values are `values`.
-    pub(super) fn array(&mut self, depth: usize, name: &str, ncomp: usize, values: Values) {
-        let (ty, bytes) = match values {
-            Values::Real(v) => match self.format.precision {
-                Precision::F64 => ("Float64", v.iter().flat_map(|x| x.to_le_bytes()).collect()),
-                Precision::F32 => (
-                    "Float32",
-                    v.iter().flat_map(|&x| (x as f32).to_le_bytes()).collect(),
-                ),
-            },
-            Values::Int64(v) => ("Int64", v.iter().flat_map(|x| x.to_le_bytes()).collect()),
-            Values::UInt8(v) => ("UInt8", v),
+    /// Append a floating-point `DataArray` of `ncomp` components per tuple, `name`, at the
+    /// file's precision.
+    pub(super) fn reals(
+        &mut self,
+        depth: usize,
+        name: &str,
+        ncomp: usize,
+        values: impl Iterator<Item = f64>,
+    ) {
+        let (ty, bytes) = match self.format.precision {
+            Precision::F64 => ("Float64", values.flat_map(f64::to_le_bytes).collect()),
+            Precision::F32 => (
+                "Float32",
+                values.flat_map(|x| (x as f32).to_le_bytes()).collect(),
+            ),
         };
+        self.array(depth, ty, name, ncomp, bytes);
+    }
+
+    /// Append an `Int64` array of one component (connectivity, offsets).
+    pub(super) fn int64s(&mut self, depth: usize, name: &str, values: impl Iterator<Item = i64>) {
+        let bytes = values.flat_map(i64::to_le_bytes).collect();
+        self.array(depth, "Int64", name, 1, bytes);
+    }
+
+    /// Append a `UInt8` array of one component (cell types).
+    pub(super) fn uint8s(&mut self, depth: usize, name: &str, values: Vec<u8>) {
+        self.array(depth, "UInt8", name, 1, values);
+    }
+
+    /// Append a `DataArray` of VTK type `ty`, `ncomp` components per tuple, `name`, whose
+    /// little-endian values are `bytes`.
+    fn array(&mut self, depth: usize, ty: &str, name: &str, ncomp: usize, bytes: Vec<u8>) {
         let name = match name {
             "" => String::new(),
             n => format!(" Name=\"{}\"", xml_escape(n)),
@@ -162,16 +181,6 @@ impl Body {
         out.write_all(&self.data)?;
         out.write_all(b"\n  </AppendedData>\n</VTKFile>\n")
     }
-}
-
-/// The values of one data array.
-pub(super) enum Values {
-    /// Floating point values, written at the file's precision.
-    Real(Vec<f64>),
-    /// 64-bit integers.
-    Int64(Vec<i64>),
-    /// Bytes.
-    UInt8(Vec<u8>),
 }
 
 /// One chunk compressed by zlib.

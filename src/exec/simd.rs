@@ -4,8 +4,8 @@
 //! x86-64 machine with it, e.g. a cluster's compute nodes as well as the login node it was
 //! built on. The hot loops are compiled several times — for AVX-512, for AVX2 with FMA and
 //! for the baseline — and the widest variant the CPU has is picked at run time
-//! (`is_x86_feature_detected!`, once). `multiversion!` makes such a
-//! function. Every variant computes the same numbers bit for bit: Rust never contracts
+//! (`is_x86_feature_detected!`, once): [`dispatch!`] runs an expression so, `multiversion!` makes
+//! a function so. Every variant computes the same numbers bit for bit: Rust never contracts
 //! `a·b + c` into a fused multiply-add on its own, does not reorder floating-point sums, and
 //! `mul_add` is fused at every level.
 
@@ -44,9 +44,57 @@ fn detect() -> Level {
     Level::Baseline
 }
 
+/// Evaluates an expression in a copy of the code compiled for this CPU's [`Level`] (checked
+/// at each use: one predictable branch, so use it per chunk of work, not per element).
+///
+/// ```ignore
+/// crate::exec::simd::dispatch!(kernel::<T>(a, b))
+/// ```
+///
+/// The expression becomes an `#[inline(always)]` closure inlined into one
+/// `#[target_feature]` copy per level ([`at_level`]), and with it what it inlines: make the
+/// function it calls `#[inline(always)]` too (a plain call stays a baseline function).
+/// Closures it hands to rayon are not compiled for the level (they run elsewhere): dispatch
+/// inside them instead.
+macro_rules! dispatch {
+    ($e:expr) => {
+        $crate::exec::simd::at_level(
+            #[inline(always)]
+            || $e,
+        )
+    };
+}
+
+pub(crate) use dispatch;
+
+/// Calls `f` from a copy compiled for this CPU's [`Level`]; use [`dispatch!`], which makes
+/// `f` an `#[inline(always)]` closure (without that, a large `f` called from three copies
+/// may stay one baseline function, as measured on the MPM point pass).
+#[inline(always)]
+pub(crate) fn at_level<R>(f: impl FnOnce() -> R) -> R {
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx2,fma")]
+    unsafe fn avx512<R>(f: impl FnOnce() -> R) -> R {
+        f()
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn avx2<R>(f: impl FnOnce() -> R) -> R {
+        f()
+    }
+    match level() {
+        // SAFETY: `level` found the features on this CPU.
+        #[cfg(target_arch = "x86_64")]
+        Level::Avx512 => unsafe { avx512(f) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Level::Avx2 => unsafe { avx2(f) },
+        _ => f(),
+    }
+}
+
 /// Defines a function whose body is compiled for every [`Level`] and run at this CPU's
-/// ([`level`]), checked at each call (one predictable branch: call it per chunk of work, not
-/// per element).
+/// ([`dispatch!`]).
 ///
 /// ```ignore
 /// multiversion! {
@@ -55,10 +103,9 @@ fn detect() -> Level {
 /// }
 /// ```
 ///
-/// The body is an `#[inline(always)]` function inlined into one `#[target_feature]` copy per
-/// level, so what it calls and inlines is compiled for that level too; closures it hands to
-/// rayon are not (they run elsewhere): dispatch inside them instead. The function may not be
-/// generic, and its argument types use elided lifetimes only.
+/// The body becomes an `#[inline(always)]` function called through [`dispatch!`]. The
+/// function may not be generic, and its argument types use elided lifetimes only (for a
+/// generic kernel, use [`dispatch!`] on a call of it).
 macro_rules! multiversion {
     ($(#[$attr:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)?
         $body:block) => {
@@ -66,25 +113,7 @@ macro_rules! multiversion {
         $vis fn $name($($arg: $ty),*) $(-> $ret)? {
             #[inline(always)]
             fn body($($arg: $ty),*) $(-> $ret)? $body
-            #[cfg(target_arch = "x86_64")]
-            #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx2,fma")]
-            unsafe fn avx512($($arg: $ty),*) $(-> $ret)? {
-                body($($arg),*)
-            }
-            #[cfg(target_arch = "x86_64")]
-            #[target_feature(enable = "avx2,fma")]
-            unsafe fn avx2($($arg: $ty),*) $(-> $ret)? {
-                body($($arg),*)
-            }
-            match $crate::exec::simd::level() {
-                // SAFETY: `level` found the features on this CPU.
-                #[cfg(target_arch = "x86_64")]
-                $crate::exec::simd::Level::Avx512 => unsafe { avx512($($arg),*) },
-                // SAFETY: as above.
-                #[cfg(target_arch = "x86_64")]
-                $crate::exec::simd::Level::Avx2 => unsafe { avx2($($arg),*) },
-                _ => body($($arg),*),
-            }
+            $crate::exec::simd::dispatch!(body($($arg),*))
         }
     };
 }

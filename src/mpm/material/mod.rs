@@ -112,7 +112,7 @@ pub enum MaterialModel {
 
 impl Material for MaterialModel {
     type State = MaterialState;
-    #[inline]
+    #[inline(always)]
     fn update_stress(
         &self,
         stress: &Stress,

@@ -195,6 +195,7 @@ impl MohrCoulomb {
     }
 
     /// Return a sorted principal trial stress σ_B (σ₁ ≥ σ₂ ≥ σ₃) to the admissible set.
+    #[inline(always)]
     pub fn return_principal(&self, sb: &P3) -> (P3, Return) {
         let dv = &self.derived;
         let (k, sc) = (dv.k, dv.sigma_c);
@@ -265,7 +266,10 @@ impl MohrCoulomb {
         (s, kind)
     }
 
-    /// Full update with the return reported (see [`Material::update_stress`]).
+    /// Full update with the return reported (see [`Material::update_stress`]); inlined so
+    /// that it is compiled for the vector extensions of the point pass that calls it
+    /// ([`crate::exec::simd`]).
+    #[inline(always)]
     pub fn update(
         &self,
         stress: &Stress,
@@ -323,7 +327,7 @@ impl MohrCoulomb {
 
 impl Material for MohrCoulomb {
     type State = MaterialState;
-    #[inline]
+    #[inline(always)]
     fn update_stress(
         &self,
         stress: &Stress,

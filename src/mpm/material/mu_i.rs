@@ -82,7 +82,7 @@ impl MuIMohrCoulomb {
 
 impl Material for MuIMohrCoulomb {
     type State = MaterialState;
-    #[inline]
+    #[inline(always)]
     fn update_stress(
         &self,
         stress: &Stress,

@@ -268,6 +268,21 @@ fn stencil(shape: ShapeKind, origin: [f64; 2], h: f64, p: [f64; 2], lp: f64) -> 
     }
 }
 
+/// The stencils `out` of the points at `x` with half-sizes `lp`.
+#[inline(always)]
+fn stencils(
+    shape: ShapeKind,
+    origin: [f64; 2],
+    h: f64,
+    x: &[[f64; 2]],
+    lp: &[f64],
+    out: &mut [Stencil],
+) {
+    for ((st, &x), &lp) in out.iter_mut().zip(x).zip(lp) {
+        *st = stencil(shape, origin, h, x, lp);
+    }
+}
+
 /// The CFL limit C h/c, c = √((K + 4G/3)/ρ).
 pub fn cfl_step(material: &impl Material, h: f64, courant: f64) -> f64 {
     courant * h / (material.p_wave_modulus() / material.density()).sqrt()

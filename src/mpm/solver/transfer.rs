@@ -5,6 +5,7 @@
 use rayon::prelude::*;
 
 use super::*;
+use crate::exec::simd;
 
 impl<M: Material> Mpm<M> {
     /// Re-sort the points into cell order (x-major, as the nodes).
@@ -58,10 +59,12 @@ impl<M: Material> Mpm<M> {
         self.stripe_start.iter_mut().for_each(|c| *c = 0);
         let (origin, h) = (g.origin, g.h);
         self.stencils
-            .par_iter_mut()
-            .zip(self.points.pos.par_iter())
-            .zip(self.points.half_size.par_iter())
-            .for_each(|((st, &x), &lp)| *st = stencil(shape, origin, h, x, lp));
+            .par_chunks_mut(CHUNK)
+            .zip(self.points.pos.par_chunks(CHUNK))
+            .zip(self.points.half_size.par_chunks(CHUNK))
+            .for_each(|((sts, xs), lps)| {
+                simd::dispatch!(stencils(shape, origin, h, xs, lps, sts));
+            });
         for (p, (&x, st)) in self.points.pos.iter().zip(&self.stencils).enumerate() {
             let ok = x[0].is_finite()
                 && x[1].is_finite()
@@ -119,8 +122,6 @@ impl<M: Material> Mpm<M> {
 
     /// Scatter point quantities to the nodes. `mass`: mass and momentum; `force`: internal and
     /// gravity force; `momentum`: momentum only (MUSL re-map; mass kept).
-    // The stencil loops index several 3-arrays (weights, gradients, offsets) by node.
-    #[allow(clippy::needless_range_loop)]
     #[inline(always)]
     pub(super) fn p2g(&mut self, mass: bool, force: bool, momentum: bool) {
         // The transfer is a const parameter so the FLIP path carries no APIC branches.
@@ -131,18 +132,24 @@ impl<M: Material> Mpm<M> {
         }
     }
 
-    #[allow(clippy::needless_range_loop)]
     #[inline(always)]
     pub(super) fn p2g_with<const APIC: bool>(&mut self, mass: bool, force: bool, momentum: bool) {
         let g = &mut self.grid;
         let nny = g.ny + 1;
-        let pts = &self.points;
-        let grav = self.params.gravity;
-        let (order, starts) = (&self.order, &self.stripe_start);
-        let stencils = &self.stencils;
-        let ns = starts.len() - 1;
-        let apic = APIC;
-        let (origin, h) = (g.origin, g.h);
+        let ns = self.stripe_start.len() - 1;
+        let scatter = Scatter {
+            pts: &self.points,
+            order: &self.order,
+            starts: &self.stripe_start,
+            stencils: &self.stencils,
+            grav: self.params.gravity,
+            origin: g.origin,
+            h: g.h,
+            nny,
+            mass,
+            force,
+            momentum,
+        };
         g.sums.par_iter_mut().for_each(|s| {
             if mass {
                 s[0] = 0.0;
@@ -164,58 +171,8 @@ impl<M: Material> Mpm<M> {
                 .enumerate()
                 .for_each(|(k, chunk): (usize, &mut [NodeSums])| {
                     let s = 2 * k + phase;
-                    if s >= ns {
-                        return;
-                    }
-                    let col0 = (s * STRIPE) as i64;
-                    for &q in &order[starts[s]..starts[s + 1]] {
-                        let q = q as usize;
-                        let st = &stencils[q];
-                        let m = pts.mass[q];
-                        let v = pts.vel[q];
-                        let vol = pts.vol[q];
-                        let sg = pts.stress[q];
-                        // APIC: C = B D⁻¹ with D = diag(Σ w_x d_x², Σ w_y d_y²) here.
-                        let (mut c, mut dx, mut dy) = ([0.0; 4], [0.0; 3], [0.0; 3]);
-                        if apic {
-                            let x = pts.pos[q];
-                            let (mut ddx, mut ddy) = (0.0, 0.0);
-                            for k in 0..3 {
-                                dx[k] = origin[0] + (st.i0 + k as i64) as f64 * h - x[0];
-                                dy[k] = origin[1] + (st.j0 + k as i64) as f64 * h - x[1];
-                                ddx += st.wx[k] * dx[k] * dx[k];
-                                ddy += st.wy[k] * dy[k] * dy[k];
-                            }
-                            let bm = pts.affine[q];
-                            c = [bm[0] / ddx, bm[1] / ddy, bm[2] / ddx, bm[3] / ddy];
-                        }
-                        for a in 0..3 {
-                            let base = (st.i0 + a as i64 - col0) as usize * nny + st.j0 as usize;
-                            for b in 0..3 {
-                                let w = st.wx[a] * st.wy[b];
-                                let node = &mut chunk[base + b];
-                                if mass {
-                                    node[0] += w * m;
-                                }
-                                if apic {
-                                    let u = [
-                                        v[0] + c[0] * dx[a] + c[1] * dy[b],
-                                        v[1] + c[2] * dx[a] + c[3] * dy[b],
-                                    ];
-                                    node[1] += w * m * u[0];
-                                    node[2] += w * m * u[1];
-                                } else if mass || momentum {
-                                    node[1] += w * m * v[0];
-                                    node[2] += w * m * v[1];
-                                }
-                                if force {
-                                    let gx = st.gx[a] * st.wy[b];
-                                    let gy = st.wx[a] * st.gy[b];
-                                    node[3] += -vol * (sg[0] * gx + sg[2] * gy) + w * m * grav[0];
-                                    node[4] += -vol * (sg[2] * gx + sg[1] * gy) + w * m * grav[1];
-                                }
-                            }
-                        }
+                    if s < ns {
+                        simd::dispatch!(scatter.stripe::<APIC>(s, chunk));
                     }
                 });
         }
@@ -316,16 +273,7 @@ impl<M: Material> Mpm<M> {
     #[inline(always)]
     pub(super) fn point_pass_with<const APIC: bool>(&mut self, pass: PointPass) -> Result<()> {
         let g = &self.grid;
-        let (h, origin, nny) = (g.h, g.origin, g.ny + 1);
-        let (vold, vnew) = (&g.vel, &g.vel_new);
-        let vstrain = match pass {
-            PointPass::All => &g.vel_new,
-            _ => &g.vel_map,
-        };
-        let dt = self.dt;
-        let pic = self.params.pic_fraction;
-        let apic = APIC;
-        let mat = &self.material;
+        let (h, origin) = (g.h, g.origin);
         let do_v = matches!(
             pass,
             PointPass::Velocity | PointPass::All | PointPass::VelocityAndMove
@@ -338,9 +286,25 @@ impl<M: Material> Mpm<M> {
             pass,
             PointPass::All | PointPass::StressFromMap | PointPass::StressFromMapAndMove
         );
-        let stencils = &self.stencils;
-        let p = &mut self.points;
         let chunk = if do_s { M::POINTS_PER_TASK } else { CHUNK };
+        let gather = Gather {
+            vold: &g.vel,
+            vnew: &g.vel_new,
+            vstrain: match pass {
+                PointPass::All => &g.vel_new,
+                _ => &g.vel_map,
+            },
+            material: &self.material,
+            origin,
+            h,
+            nny: g.ny + 1,
+            dt: self.dt,
+            pic: self.params.pic_fraction,
+            do_v,
+            do_x,
+            do_s,
+        };
+        let p = &mut self.points;
         let bad = (
             p.pos.par_chunks_mut(chunk),
             p.vel.par_chunks_mut(chunk),
@@ -350,109 +314,29 @@ impl<M: Material> Mpm<M> {
             p.state.par_chunks_mut(chunk),
             p.work.par_chunks_mut(chunk),
             p.vol0.par_chunks(chunk),
-            stencils.par_chunks(chunk),
+            self.stencils.par_chunks(chunk),
             p.affine.par_chunks_mut(chunk),
         )
             .into_par_iter()
-            .enumerate()
             .map(
-                |(k, (pos, vel, fg, vol, sig, state, work, vol0, sts, aff))| {
-                    let mut bad = None;
-                    for q in 0..pos.len() {
-                        let st = &sts[q];
-                        let mut dv = [0.0; 2];
-                        let mut xn = [0.0; 2];
-                        let mut l = [0.0; 4];
-                        let mut bm = [0.0; 4];
-                        for a in 0..3 {
-                            let base = (st.i0 + a as i64) as usize * nny + st.j0 as usize;
-                            for b in 0..3 {
-                                let n = base + b;
-                                let w = st.wx[a] * st.wy[b];
-                                if do_v {
-                                    dv[0] += w * (vnew[n][0] - vold[n][0]);
-                                    dv[1] += w * (vnew[n][1] - vold[n][1]);
-                                }
-                                if do_x || pic > 0.0 || apic {
-                                    xn[0] += w * vnew[n][0];
-                                    xn[1] += w * vnew[n][1];
-                                }
-                                if apic && do_v {
-                                    let d = [
-                                        origin[0] + (st.i0 + a as i64) as f64 * h - pos[q][0],
-                                        origin[1] + (st.j0 + b as i64) as f64 * h - pos[q][1],
-                                    ];
-                                    let u = vnew[n];
-                                    bm[0] += w * u[0] * d[0];
-                                    bm[1] += w * u[0] * d[1];
-                                    bm[2] += w * u[1] * d[0];
-                                    bm[3] += w * u[1] * d[1];
-                                }
-                                if do_s {
-                                    let gx = st.gx[a] * st.wy[b];
-                                    let gy = st.wx[a] * st.gy[b];
-                                    let v = vstrain[n];
-                                    l[0] += v[0] * gx;
-                                    l[1] += v[0] * gy;
-                                    l[2] += v[1] * gx;
-                                    l[3] += v[1] * gy;
-                                }
-                            }
-                        }
-                        if do_v && apic {
-                            vel[q] = xn;
-                            aff[q] = bm;
-                        } else if do_v {
-                            // FLIP increment, blended with the PIC velocity Σ N v^{n+1}.
-                            vel[q][0] = (1.0 - pic) * (vel[q][0] + dv[0]) + pic * xn[0];
-                            vel[q][1] = (1.0 - pic) * (vel[q][1] + dv[1]) + pic * xn[1];
-                        }
-                        if do_s {
-                            let f = fg[q];
-                            let a = [1.0 + dt * l[0], dt * l[1], dt * l[2], 1.0 + dt * l[3]];
-                            let fnew = [
-                                a[0] * f[0] + a[1] * f[2],
-                                a[0] * f[1] + a[1] * f[3],
-                                a[2] * f[0] + a[3] * f[2],
-                                a[2] * f[1] + a[3] * f[3],
-                            ];
-                            let j = fnew[0] * fnew[3] - fnew[1] * fnew[2];
-                            if (j.is_nan() || j <= 0.0) && bad.is_none() {
-                                bad = Some((k * chunk + q, format!("det F = {j:e} ≤ 0")));
-                            }
-                            fg[q] = fnew;
-                            let vnew_ = j * vol0[q];
-                            let de = [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])];
-                            let spin = 0.5 * dt * (l[1] - l[2]);
-                            let s0 = sig[q];
-                            let s1 = match mat.update_stress(&s0, &de, spin, dt, &mut state[q]) {
-                                Ok(s1) => s1,
-                                Err(why) => {
-                                    bad = bad.or(Some((k * chunk + q, why)));
-                                    s0
-                                }
-                            };
-                            let smid = [
-                                0.5 * (s0[0] + s1[0]),
-                                0.5 * (s0[1] + s1[1]),
-                                0.5 * (s0[2] + s1[2]),
-                            ];
-                            work[q] += 0.5
-                                * (vol[q] + vnew_)
-                                * (smid[0] * de[0] + smid[1] * de[1] + 2.0 * smid[2] * de[2]);
-                            sig[q] = s1;
-                            vol[q] = vnew_;
-                        }
-                        if do_x {
-                            pos[q][0] += dt * xn[0];
-                            pos[q][1] += dt * xn[1];
-                        }
-                    }
-                    bad
+                |(pos, vel, def_grad, vol, stress, state, work, vol0, stencils, affine)| {
+                    let pts = PointChunk {
+                        pos,
+                        vel,
+                        def_grad,
+                        vol,
+                        stress,
+                        state,
+                        work,
+                        vol0,
+                        stencils,
+                        affine,
+                    };
+                    simd::dispatch!(gather.chunk::<APIC>(pts))
                 },
             )
-            .find_any(|b| b.is_some())
-            .flatten();
+            .enumerate()
+            .find_map_any(|(k, bad)| bad.map(|(q, why)| (k * chunk + q, why)));
         if let Some((q, why)) = bad {
             let x = self.points.pos[q];
             return Err(Error::Unstable {
@@ -464,5 +348,259 @@ impl<M: Material> Mpm<M> {
             });
         }
         Ok(())
+    }
+}
+
+/// What the point → grid scatter of a stripe reads ([`Mpm::p2g`]).
+struct Scatter<'a, S> {
+    pts: &'a Points<S>,
+    order: &'a [u32],
+    starts: &'a [usize],
+    stencils: &'a [Stencil],
+    grav: [f64; 2],
+    origin: [f64; 2],
+    h: f64,
+    /// Nodes per grid column.
+    nny: usize,
+    mass: bool,
+    force: bool,
+    momentum: bool,
+}
+
+impl<S> Scatter<'_, S> {
+    /// Scatter the points of stripe `s` into `chunk`, its node columns (and the next
+    /// stripe's, which no other task of this phase touches): m_i += N m, p_i += N m v (APIC:
+    /// v + C (x_i − x)), f_i += −V σ ∇N + N m g.
+    // The stencil loops index several 3-arrays (weights, gradients, offsets) by node.
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    fn stripe<const APIC: bool>(&self, s: usize, chunk: &mut [NodeSums]) {
+        let Scatter {
+            pts,
+            order,
+            starts,
+            stencils,
+            grav,
+            origin,
+            h,
+            nny,
+            mass,
+            force,
+            momentum,
+        } = *self;
+        let col0 = (s * STRIPE) as i64;
+        for &q in &order[starts[s]..starts[s + 1]] {
+            let q = q as usize;
+            let st = &stencils[q];
+            let m = pts.mass[q];
+            let v = pts.vel[q];
+            let vol = pts.vol[q];
+            let sg = pts.stress[q];
+            // APIC: C = B D⁻¹ with D = diag(Σ w_x d_x², Σ w_y d_y²) here.
+            let (mut c, mut dx, mut dy) = ([0.0; 4], [0.0; 3], [0.0; 3]);
+            if APIC {
+                let x = pts.pos[q];
+                let (mut ddx, mut ddy) = (0.0, 0.0);
+                for k in 0..3 {
+                    dx[k] = origin[0] + (st.i0 + k as i64) as f64 * h - x[0];
+                    dy[k] = origin[1] + (st.j0 + k as i64) as f64 * h - x[1];
+                    ddx += st.wx[k] * dx[k] * dx[k];
+                    ddy += st.wy[k] * dy[k] * dy[k];
+                }
+                let bm = pts.affine[q];
+                c = [bm[0] / ddx, bm[1] / ddy, bm[2] / ddx, bm[3] / ddy];
+            }
+            for a in 0..3 {
+                let base = (st.i0 + a as i64 - col0) as usize * nny + st.j0 as usize;
+                for b in 0..3 {
+                    let w = st.wx[a] * st.wy[b];
+                    let node = &mut chunk[base + b];
+                    if mass {
+                        node[0] += w * m;
+                    }
+                    if APIC {
+                        let u = [
+                            v[0] + c[0] * dx[a] + c[1] * dy[b],
+                            v[1] + c[2] * dx[a] + c[3] * dy[b],
+                        ];
+                        node[1] += w * m * u[0];
+                        node[2] += w * m * u[1];
+                    } else if mass || momentum {
+                        node[1] += w * m * v[0];
+                        node[2] += w * m * v[1];
+                    }
+                    if force {
+                        let gx = st.gx[a] * st.wy[b];
+                        let gy = st.wx[a] * st.gy[b];
+                        node[3] += -vol * (sg[0] * gx + sg[2] * gy) + w * m * grav[0];
+                        node[4] += -vol * (sg[2] * gx + sg[1] * gy) + w * m * grav[1];
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// What a grid → point pass reads ([`Mpm::point_pass`]).
+struct Gather<'a, M> {
+    /// Grid velocity before the update (the FLIP reference).
+    vold: &'a [[f64; 2]],
+    /// v^{n+1}.
+    vnew: &'a [[f64; 2]],
+    /// The velocity whose gradient strains the points.
+    vstrain: &'a [[f64; 2]],
+    material: &'a M,
+    origin: [f64; 2],
+    h: f64,
+    /// Nodes per grid column.
+    nny: usize,
+    dt: f64,
+    pic: f64,
+    /// Update the velocity.
+    do_v: bool,
+    /// Move the points.
+    do_x: bool,
+    /// Strain the points and update their stress.
+    do_s: bool,
+}
+
+/// One chunk of the point arrays, as a grid → point pass changes them.
+struct PointChunk<'a, S> {
+    pos: &'a mut [[f64; 2]],
+    vel: &'a mut [[f64; 2]],
+    def_grad: &'a mut [[f64; 4]],
+    vol: &'a mut [f64],
+    stress: &'a mut [Stress],
+    state: &'a mut [S],
+    work: &'a mut [f64],
+    vol0: &'a [f64],
+    stencils: &'a [Stencil],
+    affine: &'a mut [[f64; 4]],
+}
+
+impl<M: Material> Gather<'_, M> {
+    /// Gather v^{n+1} (FLIP/PIC blend, or APIC's v and B), strain F ← (1 + Δt L) F with
+    /// L = Σ v_i ⊗ ∇N, update the stress and the work, move x += Δt Σ N v^{n+1}; the first
+    /// point (index in the chunk) whose update failed and why.
+    #[inline(always)]
+    fn chunk<const APIC: bool>(&self, pts: PointChunk<'_, M::State>) -> Option<(usize, String)> {
+        let Gather {
+            vold,
+            vnew,
+            vstrain,
+            material: mat,
+            origin,
+            h,
+            nny,
+            dt,
+            pic,
+            do_v,
+            do_x,
+            do_s,
+        } = *self;
+        let PointChunk {
+            pos,
+            vel,
+            def_grad: fg,
+            vol,
+            stress: sig,
+            state,
+            work,
+            vol0,
+            stencils: sts,
+            affine: aff,
+        } = pts;
+        let mut bad = None;
+        for q in 0..pos.len() {
+            let st = &sts[q];
+            let mut dv = [0.0; 2];
+            let mut xn = [0.0; 2];
+            let mut l = [0.0; 4];
+            let mut bm = [0.0; 4];
+            for a in 0..3 {
+                let base = (st.i0 + a as i64) as usize * nny + st.j0 as usize;
+                for b in 0..3 {
+                    let n = base + b;
+                    let w = st.wx[a] * st.wy[b];
+                    if do_v {
+                        dv[0] += w * (vnew[n][0] - vold[n][0]);
+                        dv[1] += w * (vnew[n][1] - vold[n][1]);
+                    }
+                    if do_x || pic > 0.0 || APIC {
+                        xn[0] += w * vnew[n][0];
+                        xn[1] += w * vnew[n][1];
+                    }
+                    if APIC && do_v {
+                        let d = [
+                            origin[0] + (st.i0 + a as i64) as f64 * h - pos[q][0],
+                            origin[1] + (st.j0 + b as i64) as f64 * h - pos[q][1],
+                        ];
+                        let u = vnew[n];
+                        bm[0] += w * u[0] * d[0];
+                        bm[1] += w * u[0] * d[1];
+                        bm[2] += w * u[1] * d[0];
+                        bm[3] += w * u[1] * d[1];
+                    }
+                    if do_s {
+                        let gx = st.gx[a] * st.wy[b];
+                        let gy = st.wx[a] * st.gy[b];
+                        let v = vstrain[n];
+                        l[0] += v[0] * gx;
+                        l[1] += v[0] * gy;
+                        l[2] += v[1] * gx;
+                        l[3] += v[1] * gy;
+                    }
+                }
+            }
+            if do_v && APIC {
+                vel[q] = xn;
+                aff[q] = bm;
+            } else if do_v {
+                // FLIP increment, blended with the PIC velocity Σ N v^{n+1}.
+                vel[q][0] = (1.0 - pic) * (vel[q][0] + dv[0]) + pic * xn[0];
+                vel[q][1] = (1.0 - pic) * (vel[q][1] + dv[1]) + pic * xn[1];
+            }
+            if do_s {
+                let f = fg[q];
+                let a = [1.0 + dt * l[0], dt * l[1], dt * l[2], 1.0 + dt * l[3]];
+                let fnew = [
+                    a[0] * f[0] + a[1] * f[2],
+                    a[0] * f[1] + a[1] * f[3],
+                    a[2] * f[0] + a[3] * f[2],
+                    a[2] * f[1] + a[3] * f[3],
+                ];
+                let j = fnew[0] * fnew[3] - fnew[1] * fnew[2];
+                if (j.is_nan() || j <= 0.0) && bad.is_none() {
+                    bad = Some((q, format!("det F = {j:e} ≤ 0")));
+                }
+                fg[q] = fnew;
+                let vnew_ = j * vol0[q];
+                let de = [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])];
+                let spin = 0.5 * dt * (l[1] - l[2]);
+                let s0 = sig[q];
+                let s1 = match mat.update_stress(&s0, &de, spin, dt, &mut state[q]) {
+                    Ok(s1) => s1,
+                    Err(why) => {
+                        bad = bad.or(Some((q, why)));
+                        s0
+                    }
+                };
+                let smid = [
+                    0.5 * (s0[0] + s1[0]),
+                    0.5 * (s0[1] + s1[1]),
+                    0.5 * (s0[2] + s1[2]),
+                ];
+                work[q] += 0.5
+                    * (vol[q] + vnew_)
+                    * (smid[0] * de[0] + smid[1] * de[1] + 2.0 * smid[2] * de[2]);
+                sig[q] = s1;
+                vol[q] = vnew_;
+            }
+            if do_x {
+                pos[q][0] += dt * xn[0];
+                pos[q][1] += dt * xn[1];
+            }
+        }
+        bad
     }
 }

@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand, ValueEnum};
+use granflow::scenario::overrides::Override;
 
 #[derive(Parser)]
 #[command(
@@ -26,11 +27,19 @@ enum Command {
     Check {
         /// Scenario file (TOML).
         scenario: PathBuf,
+        /// Change a key of the file, e.g. --set time.end=2.0 (a dotted path; repeat for more;
+        /// docs/scenario-format.md, "--set").
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<Override>,
     },
     /// Run a scenario and write series.pvd + frames, timeseries.csv and summary.json.
     Run {
         /// Scenario file (TOML).
         scenario: PathBuf,
+        /// Change a key of the file, e.g. --set grain_contact.friction=0.4 (a dotted path;
+        /// repeat for more); the output folder's scenario.toml records it.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<Override>,
         /// Output folder (created if needed; one that holds an earlier run is refused unless
         /// --force).
         #[arg(long)]
@@ -331,15 +340,17 @@ fn out_of(dir: &std::path::Path, force: bool) -> cli::Out<'_> {
 
 fn real_main() -> Result<ExitCode> {
     match Cli::parse().command {
-        Command::Check { scenario } => cli::run::check(&scenario),
+        Command::Check { scenario, set } => cli::run::check(&scenario, &set),
         Command::Run {
             scenario,
+            set,
             out,
             force,
             rve_frames,
             checkpoint_every,
         } => cli::run::run(
             &scenario,
+            &set,
             out_of(&out, force),
             &rve_frames,
             checkpoint_every,

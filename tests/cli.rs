@@ -528,3 +528,73 @@ fn a_run_larger_than_memory_is_refused() {
     );
     assert!(!out_dir.exists());
 }
+
+/// `--set` changes a key as an edit of the file would: `check` derives from the new value, an
+/// unknown key or a bad value is refused naming it with nothing written, and `run` keeps the
+/// changed scenario (with the overrides listed) in its output folder.
+#[test]
+fn set_changes_keys_as_the_file_would() {
+    let check = |sets: &[&str]| {
+        let mut c = granflow();
+        c.arg("check").arg(data("tiny_channel.toml"));
+        for s in sets {
+            c.args(["--set", s]);
+        }
+        c.output().unwrap()
+    };
+    // τ = 0.65: dt = (τ − ½)dx²/(3ν) = 0.15 · 0.000625² / 3e-6 = 0.01953125 s.
+    let out = check(&["time.tau=0.65", "lbm.collision=bgk"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("1.953125e-2 s"), "{text}");
+    assert!(text.contains("collision       Bgk"), "{text}");
+    for (set, expect) in [
+        ("time.tua=0.65", "unknown field `tua`"),
+        ("time.tau=0.4", "time.tau"),
+        ("time.tau=fast", "tau = \"fast\""),
+        ("obstacles.1.radius=0.001", "`obstacles.1` is not an index"),
+        ("time.tau", "KEY=VALUE"),
+    ] {
+        let out = check(&[set]);
+        assert!(!out.status.success(), "{set} was taken");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(expect), "{set}: expected `{expect}` in {err}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let refused = run_to(
+        &data("tiny_channel.toml"),
+        &dir.path().join("no"),
+        &["--set", "time.end=-1"],
+    );
+    assert!(!refused.status.success());
+    assert!(
+        !dir.path().join("no").exists(),
+        "a refused run wrote its folder"
+    );
+    let out_dir = dir.path().join("run");
+    let out = run_to(
+        &data("tiny_channel.toml"),
+        &out_dir,
+        &["--set", "time.end=10.0", "--set", "time.frame_interval=5.0"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let kept = std::fs::read_to_string(out_dir.join("scenario.toml")).unwrap();
+    assert!(
+        kept.starts_with(
+            "# run with overrides (granflow --set):\n#   time.end=10.0\n#   time.frame_interval=5.0\n"
+        ),
+        "{kept}"
+    );
+    assert!(kept.contains("# A small force-driven channel"), "{kept}");
+    // 10 s at a 5 s frame interval: frames at 0, 5, 10 s.
+    let pvd = std::fs::read_to_string(out_dir.join("series.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 3, "{pvd}");
+}

@@ -11,24 +11,41 @@ use granflow::scenario::dem::DemScenario;
 use granflow::scenario::fluid::Scenario;
 use granflow::scenario::mpm::spec::Law;
 use granflow::scenario::mpm::MpmScenario;
+use granflow::scenario::overrides::Override;
 use granflow::scenario::submerged::SubmergedScenario;
-use granflow::scenario::{kind_of_file, Kind, ScenarioFile};
+use granflow::scenario::{Kind, ScenarioFile};
 
 use super::{stopped, with_progress, Out};
 
-/// `granflow check`: parse, derive and print, refuse bad input; no run.
-pub fn check(path: &Path) -> Result<ExitCode> {
-    match kind_of_file(path)? {
-        Kind::Fluid => check_fluid(path),
-        Kind::Dem => check_dem(path),
-        Kind::Mpm => check_mpm(path),
+/// `granflow check`: parse, derive and print, refuse bad input; no run. `sets`: the keys
+/// `--set` changes.
+pub fn check(path: &Path, sets: &[Override]) -> Result<ExitCode> {
+    let (kind, text) = read_scenario(path, sets)?;
+    match kind {
+        Kind::Fluid => check_fluid(&Scenario::from_text(&text, path)?),
+        Kind::Dem => check_dem(&DemScenario::from_text(&text, path)?),
+        Kind::Mpm => check_mpm(&MpmScenario::from_text(&text, path)?),
         Kind::Submerged => {
-            let s = SubmergedScenario::from_file(path)?;
+            let s = SubmergedScenario::from_text(&text, path)?;
             print!("{}", s.check_report()?);
             Ok(ExitCode::SUCCESS)
         }
         Kind::Sweep => check_sweep(path),
     }
+}
+
+/// The kind and text of the scenario file at `path`, with the keys `--set` changes; a sweep
+/// file takes none.
+fn read_scenario(path: &Path, sets: &[Override]) -> Result<(Kind, String)> {
+    let (kind, text) = granflow::scenario::read_file(path, sets)?;
+    if kind == Kind::Sweep && !sets.is_empty() {
+        anyhow::bail!(
+            "--set: {} is a sweep file; its cases take their keys from the sweep (change the \
+             sweep file)",
+            path.display()
+        );
+    }
+    Ok((kind, text))
 }
 
 /// A sweep file: its cases, resolved and checked.
@@ -42,8 +59,7 @@ fn check_sweep(path: &Path) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn check_fluid(path: &Path) -> Result<ExitCode> {
-    let s = Scenario::from_file(path)?;
+fn check_fluid(s: &Scenario) -> Result<ExitCode> {
     let d = s.derive()?;
     let u = &d.units;
     println!("scenario        {} — {}", s.name, s.description);
@@ -103,8 +119,7 @@ fn print_memory(bytes: usize) {
     println!("memory          {}", granflow::exec::memory_line(bytes));
 }
 
-fn check_dem(path: &Path) -> Result<ExitCode> {
-    let s = DemScenario::from_file(path)?;
+fn check_dem(s: &DemScenario) -> Result<ExitCode> {
     let d = s.derive()?;
     println!(
         "scenario        {} — {} (DEM column collapse)",
@@ -125,8 +140,7 @@ fn check_dem(path: &Path) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn check_mpm(path: &Path) -> Result<ExitCode> {
-    let s = MpmScenario::from_file(path)?;
+fn check_mpm(s: &MpmScenario) -> Result<ExitCode> {
     let d = s.derive()?;
     println!(
         "scenario        {} — {} (MPM column collapse)",
@@ -252,16 +266,18 @@ fn run_dem(s: &DemScenario, path: &Path, out: &Path, control: Control) -> Result
     Ok(ExitCode::SUCCESS)
 }
 
-/// `granflow run`: run a scenario and write its outputs; `volumes`: the places of the
-/// representative volumes whose grains every frame writes (`--rve-frames`, MPM files with
-/// `model = "rve"` only); `checkpoint_every`: simulated seconds between checkpoints.
+/// `granflow run`: run a scenario (with the keys `sets` changes) and write its outputs;
+/// `volumes`: the places of the representative volumes whose grains every frame writes
+/// (`--rve-frames`, MPM files with `model = "rve"` only); `checkpoint_every`: simulated
+/// seconds between checkpoints.
 pub fn run(
     path: &Path,
+    sets: &[Override],
     out: Out,
     volumes: &[[f64; 2]],
     checkpoint_every: Option<f64>,
 ) -> Result<ExitCode> {
-    let kind = kind_of_file(path)?;
+    let (kind, text) = read_scenario(path, sets)?;
     if !volumes.is_empty() && kind != Kind::Mpm {
         anyhow::bail!(
             "--rve-frames: {} is not an MPM scenario (only the points of an MPM file with \
@@ -269,50 +285,43 @@ pub fn run(
             path.display()
         );
     }
-    if kind == Kind::Sweep {
-        anyhow::bail!(
-            "{} is a sweep file: run it with `granflow sweep {} --out DIR`",
-            path.display(),
-            path.display()
-        );
-    }
-    let text = read_text(path)?;
     let control = Control::new(&text, checkpoint_every, super::stop_on_signals()?)?;
-    run_resumable(kind, path, volumes, control, |memory| {
+    run_resumable(kind, path, &text, volumes, control, |memory| {
         let dir = out.claim(memory)?;
         keep_scenario(dir, &text)?;
         Ok(dir)
     })
 }
 
-/// Parse the scenario at `path` of `kind`, take its output folder with `take(estimated peak
-/// memory)` and run it as `control` says.
+/// Parse the scenario `text` (of the file `path`) of `kind`, take its output folder with
+/// `take(estimated peak memory)` and run it as `control` says.
 fn run_resumable<'a>(
     kind: Kind,
     path: &Path,
+    text: &str,
     volumes: &[[f64; 2]],
     control: Control,
     take: impl FnOnce(usize) -> Result<&'a Path>,
 ) -> Result<ExitCode> {
     match kind {
         Kind::Fluid => {
-            let s = Scenario::from_file(path)?;
+            let s = Scenario::from_text(text, path)?;
             let dir = take(s.derive()?.memory_bytes)?;
             run_fluid(&s, path, dir, control)
         }
         Kind::Dem => {
-            let s = DemScenario::from_file(path)?;
+            let s = DemScenario::from_text(text, path)?;
             let dir = take(dem_memory(s.derive()?.grains))?;
             run_dem(&s, path, dir, control)
         }
         Kind::Mpm => {
-            let s = MpmScenario::from_file(path)?;
+            let s = MpmScenario::from_text(text, path)?;
             granflow::scenario::collapse::mpm::check_volumes(&s, volumes)?;
             let dir = take(s.derive()?.memory_bytes())?;
             run_mpm(&s, path, dir, volumes, control)
         }
         Kind::Submerged => {
-            let s = SubmergedScenario::from_file(path)?;
+            let s = SubmergedScenario::from_text(text, path)?;
             let dir = take(s.derive()?.memory_bytes)?;
             run_submerged(&s, path, dir, control)
         }
@@ -371,7 +380,7 @@ pub fn resume(dir: &Path) -> Result<ExitCode> {
     }
     let mut control = Control::new(&text, None, super::stop_on_signals()?)?;
     control.resume = true;
-    run_resumable(kind, &path, &[], control, |memory| {
+    run_resumable(kind, &path, &text, &[], control, |memory| {
         granflow::exec::check_memory(memory as u64)?;
         Ok(dir)
     })

@@ -14,7 +14,8 @@
 //! * [`submerged`]: the LBM–DEM submerged collapse;
 //! * [`collapse`]: the one column-collapse runner, for the DEM, MPM and submerged solids;
 //! * [`validation`]: the registry of validation cases (`granflow validate`);
-//! * [`checkpointing`]: checkpoints, resume and the stop signals ask for.
+//! * [`checkpointing`]: checkpoints, resume and the stop signals ask for;
+//! * [`overrides`]: keys changed on the command line (`--set`).
 //!
 //! Studies over many scenarios are in [`crate::sweep`]. Nothing in the physics storey
 //! (`lbm`, `dem`, `mpm`, `coupling`) imports this module.
@@ -24,6 +25,7 @@ pub mod collapse;
 pub mod dem;
 pub mod fluid;
 pub mod mpm;
+pub mod overrides;
 pub mod submerged;
 pub mod validation;
 
@@ -117,7 +119,13 @@ pub trait ScenarioFile: serde::de::DeserializeOwned {
     /// Read and parse a scenario file of this kind; errors name the file.
     fn from_file(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        Self::from_toml(&text).map_err(|e| in_file(e, path))
+        Self::from_text(&text, path)
+    }
+
+    /// Parse the text of the scenario file at `path` (as read by [`read_file`]); errors name
+    /// the file.
+    fn from_text(text: &str, path: &Path) -> Result<Self> {
+        Self::from_toml(text).map_err(|e| in_file(e, path))
     }
 }
 
@@ -149,6 +157,15 @@ pub fn kind_of(text: &str) -> Result<Kind> {
 pub fn kind_of_file(path: &Path) -> Result<Kind> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     kind_of(&text).map_err(|e| in_file(e, path))
+}
+
+/// The kind and text of the scenario file at `path` with the keys `overrides` changes
+/// ([`overrides::apply`]); errors name the file.
+pub fn read_file(path: &Path, overrides: &[overrides::Override]) -> Result<(Kind, String)> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = overrides::apply(&text, overrides).map_err(|e| in_file(e, path))?;
+    let kind = kind_of(&text).map_err(|e| in_file(e, path))?;
+    Ok((kind, text))
 }
 
 /// A parse error of `<text>` as an error of `path`.

@@ -6,7 +6,7 @@
 //! layout, so the copy a run keeps in its output folder shows what was run, with the
 //! overrides listed in a comment at its top.
 //!
-//! `KEY` is a dotted path of table keys (`dem.friction`, `vtk.compression`); a number picks
+//! `KEY` is a dotted path of table keys (`grain_contact.friction`, `vtk.compression`); a number picks
 //! an element of an array (`obstacles.0.radius`). A table that the file does not have is
 //! added. `VALUE` is a TOML value (`0.4`, `2e-3`, `true`, `"lz4"`, `[0.0, -9.81]`); a bare
 //! word (`mrt`) is taken as a string.
@@ -32,7 +32,7 @@ impl std::str::FromStr for Override {
     fn from_str(s: &str) -> std::result::Result<Self, String> {
         let (key, text) = s
             .split_once('=')
-            .ok_or_else(|| format!("`{s}` is not KEY=VALUE (e.g. dem.friction=0.4)"))?;
+            .ok_or_else(|| format!("`{s}` is not KEY=VALUE (e.g. time.end=2.0)"))?;
         let (key, text) = (key.trim(), text.trim());
         let path: Vec<String> = key.split('.').map(|p| p.trim().to_string()).collect();
         if path.iter().any(|p| p.is_empty()) {

@@ -49,7 +49,7 @@ fn loose_and_dense_samples_reach_one_critical_state() {
 /// only, so the sample consolidates at σ₃ and shears (before this was handled, the drag stayed
 /// on in the first consolidation and the sample never came to rest). 300 grains to ε₁ = 0.02;
 /// σ₃ held within 2 % over the second half, and the sample starts looser than the frictional
-/// deposit of `sample(0.53)` consolidated the same way (0.778, docs/dem-status.md; measured
+/// deposit of `sample(0.53)` consolidated the same way (0.778, docs/dev/dem-status.md; measured
 /// 0.764).
 #[test]
 fn a_sedimented_sample_consolidates_and_shears() {

@@ -63,7 +63,7 @@ fn compressed_hexagonal_crystal_has_the_analytic_stress() {
 /// image's γ̇ L_y, see no tangential motion. So their x velocities stay as they were (a wrong
 /// image velocity would drive the friction with a slip of γ̇ L_y = 0.2 m/s), the y momentum
 /// is conserved to round-off, and they rebound with the contact law's restitution (e = 0.75,
-/// within 1 % at λ ≈ 0.1, docs/dem-status.md).
+/// within 1 % at λ ≈ 0.1, docs/dev/dem-status.md).
 #[test]
 fn a_collision_through_the_sheared_boundary_sees_the_image_velocity() {
     let (r, l) = (0.5e-3, 20e-3);

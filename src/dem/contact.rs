@@ -29,7 +29,7 @@
 //! Velocity Verlet applies over a step [t_k, t_{k+1}] the impulse ½Δt(**F**_k + **F**_{k+1}), the
 //! trapezoidal rule. Three things make that rule lose accuracy for a spring-dashpot, and each
 //! is treated here (the numbers are for e = 0.3 at λ = 0.1, measured in the 1-D prototype
-//! behind docs/dem-status.md):
+//! behind docs/dev/dem-status.md):
 //!
 //! 1. **The dashpot is velocity dependent**, so the trapezoid needs v_{k+1}, which is what the
 //!    step is computing. Using the mid-step velocity (LAMMPS) is a first-order error (−3.6 % in

@@ -110,6 +110,16 @@ fn check_fluid(s: &Scenario) -> Result<ExitCode> {
     println!("precision       {:?}", s.lbm.precision);
     print_memory(d.memory_bytes);
     println!("obstacles       {}", s.obstacles.len());
+    match s.initial.uniform_velocity() {
+        Some([u, v]) => println!("initial         uniform, u = [{u}, {v}] m/s"),
+        None => {
+            let field = s.initial.field(d.cells, u.dx)?;
+            println!(
+                "initial         field from expressions of x, y; largest speed {:.4e} m/s",
+                field.max_speed(d.cells, u.dx)
+            );
+        }
+    }
     println!("ok");
     Ok(ExitCode::SUCCESS)
 }

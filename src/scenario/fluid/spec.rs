@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+pub use super::initial::{FieldValue, InitialField, InitialSpec};
 use crate::io::VtkFormat;
 use crate::lbm::{CollisionModel, Edge, Edges, FluidModel, LbmSetup, MrtRates, Obstacle, Shape};
 use crate::scenario::{lattice_units, positive, Kind, ScenarioFile};
@@ -223,14 +224,6 @@ pub enum EdgeSpec {
     },
 }
 
-/// Initial state: uniform density ρ and velocity.
-#[derive(Clone, Debug, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct InitialSpec {
-    /// Initial velocity in m/s.
-    pub velocity: [f64; 2],
-}
-
 /// Reference scales.
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -390,7 +383,13 @@ impl Scenario {
             }
             Ok(())
         };
-        check_u("initial.velocity", self.initial.velocity)?;
+        match self.initial.uniform_velocity() {
+            Some(u) => check_u("initial.velocity", u)?,
+            None => {
+                let speed = self.initial.field([nx, ny], dx)?.max_speed([nx, ny], dx);
+                check_u("initial.velocity", [speed, 0.0])?;
+            }
+        }
         for (name, e) in self.edges_named() {
             match e {
                 EdgeSpec::MovingWall { velocity } => {
@@ -624,11 +623,19 @@ impl Scenario {
 
 impl Scenario {
     /// Build the solver in precision `T` (whatever `lbm.precision` says), initialised to the
-    /// equilibrium at ρ₀ and `initial.velocity`.
+    /// equilibrium at ρ₀ and a uniform `initial.velocity`, or to the `[initial]` field
+    /// ([`InitialField::populations`]).
     pub fn build_typed<T: crate::lbm::Real>(&self, d: &Derived) -> Result<crate::lbm::Lbm<T>> {
-        self.lbm_setup(d)
+        let mut lbm = self
+            .lbm_setup(d)
             .build()
-            .map_err(|e| Error::config("boundaries", e))
+            .map_err(|e| Error::config("boundaries", e))?;
+        if self.initial.uniform_velocity().is_none() {
+            let field = self.initial.field(d.cells, d.units.dx)?;
+            lbm.lattice
+                .fill_populations(|i, j| field.populations(&d.units, i, j));
+        }
+        Ok(lbm)
     }
 
     /// The fluid this scenario describes, in lattice terms.
@@ -644,10 +651,11 @@ impl Scenario {
             },
             edges: self.edges(&d.units, nx, ny),
             obstacles: self.lattice_obstacles(&d.units),
-            initial_velocity: [
-                d.units.velocity_to_lattice(self.initial.velocity[0]),
-                d.units.velocity_to_lattice(self.initial.velocity[1]),
-            ],
+            initial_velocity: self
+                .initial
+                .uniform_velocity()
+                .unwrap_or_default()
+                .map(|u| d.units.velocity_to_lattice(u)),
         }
     }
 

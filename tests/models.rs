@@ -1,5 +1,5 @@
 //! Every scenario under `models/` declares its kind, parses as that kind and passes
-//! `derive()` (the `check` command).
+//! `derive()` (the `check` command); every case of every sweep file does too.
 
 use std::path::Path;
 
@@ -57,8 +57,9 @@ fn every_model_file_declares_its_kind_and_checks_as_it() {
             Kind::Submerged => SubmergedScenario::from_file(f)
                 .and_then(|s| s.derive())
                 .map(|_| ()),
-            // Expanding a sweep reads its bases; each case is checked when it runs.
-            Kind::Sweep => granflow::sweep::read_sweep(f).map(|_| ()),
+            // Every case of a sweep (its base with the sweep's keys set) checks as its kind.
+            Kind::Sweep => granflow::sweep::read_sweep(f)
+                .and_then(|(_, cases)| cases.iter().try_for_each(|c| c.check())),
         };
         if let Err(e) = checked {
             panic!("{}: {e}", f.display());

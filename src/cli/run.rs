@@ -53,7 +53,8 @@ fn check_sweep(path: &Path) -> Result<ExitCode> {
     let (spec, cases) = granflow::sweep::read_sweep(path)?;
     println!("sweep           {} — {}", spec.name, spec.description);
     for c in &cases {
-        println!("case            {}", c.name);
+        c.check()?;
+        println!("case            {} (checked)", c.name);
     }
     println!("ok ({} cases; run with `granflow sweep`)", cases.len());
     Ok(ExitCode::SUCCESS)

@@ -148,26 +148,7 @@ pub fn run_sweep(
     let (spec, cases) = read_sweep(path)?;
     // Every case must parse before anything runs: a bad value fails the sweep up front.
     for case in &cases {
-        match case.solver {
-            Solver::Dem => crate::scenario::dem::DemScenario::from_toml(&case.scenario)?
-                .derive()
-                .map(|_| ()),
-            solver => crate::scenario::mpm::MpmScenario::from_toml(&case.scenario)?
-                .derive()
-                .and_then(|d| {
-                    let rve = matches!(d.material, crate::scenario::mpm::spec::Law::Volume(_));
-                    if rve == (solver == Solver::Rve) {
-                        Ok(())
-                    } else {
-                        Err(Error::config(
-                            "material.model",
-                            "the `rve` solver takes MPM files with model = \"rve\", the `mpm` \
-                             solver the others",
-                        ))
-                    }
-                }),
-        }
-        .map_err(|e| Error::Other(format!("case `{}`: {e}", case.name)))?;
+        case.check()?;
     }
     crate::io::run_dir::create(out)?;
     let display = progress::Display::new(&cases);

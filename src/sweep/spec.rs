@@ -95,6 +95,33 @@ pub struct Case {
     pub labels: Vec<(String, Value)>,
 }
 
+impl Case {
+    /// Parse the case's scenario as its solver's kind and derive it (what `granflow check`
+    /// does for a file): a bad value is refused naming the case and the key.
+    pub fn check(&self) -> Result<()> {
+        match self.solver {
+            Solver::Dem => crate::scenario::dem::DemScenario::from_toml(&self.scenario)?
+                .derive()
+                .map(|_| ()),
+            solver => crate::scenario::mpm::MpmScenario::from_toml(&self.scenario)?
+                .derive()
+                .and_then(|d| {
+                    let rve = matches!(d.material, crate::scenario::mpm::spec::Law::Volume(_));
+                    if rve == (solver == Solver::Rve) {
+                        Ok(())
+                    } else {
+                        Err(err(
+                            "material.model",
+                            "the `rve` solver takes MPM files with model = \"rve\", the `mpm` \
+                             solver the others",
+                        ))
+                    }
+                }),
+        }
+        .map_err(|e| Error::Other(format!("case `{}`: {e}", self.name)))
+    }
+}
+
 impl ScenarioFile for SweepSpec {
     const KIND: Kind = Kind::Sweep;
 }

@@ -171,11 +171,54 @@ enum Command {
         #[arg(long)]
         seed: Option<u64>,
     },
+    /// Print the JSON Schema of a kind of scenario file (for editors' completion and checks
+    /// of the TOML files), or with --markdown its key reference (docs/scenario-keys.md is
+    /// `granflow schema all --markdown`).
+    Schema {
+        /// The kind of scenario file (its `kind` key); `all` only with --markdown.
+        #[arg(value_enum)]
+        kind: SchemaKind,
+        /// Print the Markdown key reference (a table per TOML table) instead of the schema.
+        #[arg(long)]
+        markdown: bool,
+    },
     /// Throughput benchmarks.
     Bench {
         #[command(subcommand)]
         which: Bench,
     },
+}
+
+/// The kinds `granflow schema` describes.
+#[derive(Clone, Copy, ValueEnum)]
+enum SchemaKind {
+    /// A lattice Boltzmann flow.
+    Fluid,
+    /// A DEM column collapse.
+    Dem,
+    /// A GIMPM column collapse.
+    Mpm,
+    /// A submerged (LBM–DEM) column collapse.
+    Submerged,
+    /// A study over many collapse scenarios.
+    Sweep,
+    /// Every kind (with --markdown only).
+    All,
+}
+
+impl SchemaKind {
+    /// The scenario kind; `None` for `all`.
+    fn kind(self) -> Option<granflow::scenario::Kind> {
+        use granflow::scenario::Kind;
+        match self {
+            SchemaKind::Fluid => Some(Kind::Fluid),
+            SchemaKind::Dem => Some(Kind::Dem),
+            SchemaKind::Mpm => Some(Kind::Mpm),
+            SchemaKind::Submerged => Some(Kind::Submerged),
+            SchemaKind::Sweep => Some(Kind::Sweep),
+            SchemaKind::All => None,
+        }
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -406,6 +449,7 @@ fn real_main() -> Result<ExitCode> {
             strain,
             seed,
         ),
+        Command::Schema { kind, markdown } => cli::schema::schema(kind.kind(), markdown),
         Command::Bench { which } => cli::bench::bench(which),
     }
 }

@@ -2,10 +2,12 @@
 //!
 //! * [`run`]: `check` and `run` of a scenario file of any kind (dispatched on its `kind`);
 //! * [`study`]: `validate`, `sweep`, `biaxial`, `shear`;
+//! * [`schema`]: the `schema` command;
 //! * [`bench`]: the `bench` command.
 
 pub mod bench;
 pub mod run;
+pub mod schema;
 pub mod study;
 
 use std::io::IsTerminal;

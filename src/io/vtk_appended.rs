@@ -17,7 +17,9 @@ use serde::{Deserialize, Serialize};
 use super::pvd::xml_escape;
 
 /// How VTK frames are written: the `[vtk]` table of a scenario.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(deny_unknown_fields)]
 pub struct VtkFormat {
     /// Compression of the data arrays (default zlib).
@@ -29,7 +31,9 @@ pub struct VtkFormat {
 }
 
 /// Compression of VTK data arrays.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Compression {
     /// Raw bytes.
@@ -43,8 +47,12 @@ pub enum Compression {
 }
 
 /// Precision of the floating-point values in VTK files.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
+// Named apart from the populations' precision in the schemas that have both.
+#[schemars(rename = "VtkPrecision")]
 pub enum Precision {
     /// `Float64`: the values as computed, bit for bit.
     #[default]

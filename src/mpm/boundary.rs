@@ -25,7 +25,7 @@
 use serde::{Deserialize, Serialize};
 
 /// Kind of a wall.
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case", tag = "kind", deny_unknown_fields)]
 pub enum WallKind {
     /// No motion.

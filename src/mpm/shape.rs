@@ -33,7 +33,7 @@
 use serde::{Deserialize, Serialize};
 
 /// Which shape functions the grid uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum ShapeKind {
     /// Standard MPM: bilinear hat functions of the point position (cell-crossing noise).

@@ -15,7 +15,9 @@
 //! * [`collapse`]: the one column-collapse runner, for the DEM, MPM and submerged solids;
 //! * [`validation`]: the registry of validation cases (`granflow validate`);
 //! * [`checkpointing`]: checkpoints, resume and the stop signals ask for;
-//! * [`overrides`]: keys changed on the command line (`--set`).
+//! * [`overrides`]: keys changed on the command line (`--set`);
+//! * [`schema`]: the JSON Schema of each kind and the Markdown key reference made from it
+//!   (`granflow schema`).
 //!
 //! Studies over many scenarios are in [`crate::sweep`]. Nothing in the physics storey
 //! (`lbm`, `dem`, `mpm`, `coupling`) imports this module.
@@ -26,6 +28,7 @@ pub mod dem;
 pub mod fluid;
 pub mod mpm;
 pub mod overrides;
+pub mod schema;
 pub mod submerged;
 pub mod validation;
 
@@ -37,7 +40,7 @@ use crate::units::Units;
 use crate::{Error, Result};
 
 /// What a scenario file describes: its top-level `kind` key.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum Kind {
     /// A lattice Boltzmann flow ([`fluid::Scenario`]).
@@ -96,8 +99,9 @@ impl std::fmt::Display for Kind {
     }
 }
 
-/// A scenario file's schema: one type per [`Kind`].
-pub trait ScenarioFile: serde::de::DeserializeOwned {
+/// A scenario file's schema: one type per [`Kind`]. Its JSON Schema ([`schema::of`]) is
+/// generated from the same type, so the key reference cannot drift from the parser.
+pub trait ScenarioFile: serde::de::DeserializeOwned + schemars::JsonSchema {
     /// The `kind` its files declare.
     const KIND: Kind;
 

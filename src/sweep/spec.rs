@@ -37,7 +37,9 @@ use crate::scenario::{Kind, ScenarioFile};
 use crate::{Error, Result};
 
 /// The solvers a sweep can run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Solver {
     /// The DEM column collapse (`dem::run`).
@@ -64,7 +66,7 @@ impl Solver {
 }
 
 /// The sweep file as written.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SweepSpec {
     /// `"sweep"`: what the file describes.
@@ -74,12 +76,81 @@ pub struct SweepSpec {
     /// One line on what it is for.
     pub description: String,
     /// Base scenario per solver, relative to the sweep file.
+    #[schemars(schema_with = "solvers_schema")]
     pub solvers: BTreeMap<Solver, PathBuf>,
     /// Fixed overrides applied to every case (path → value).
     #[serde(default)]
+    #[schemars(schema_with = "set_schema")]
     pub set: BTreeMap<String, Value>,
     /// The varied dimensions (path → values; the lists of one table vary together).
+    #[schemars(schema_with = "vary_schema")]
     pub vary: Vec<BTreeMap<String, Vec<Value>>>,
+}
+
+/// `[solvers]`: one optional key per [`Solver`], its name, each a path (at least one).
+fn solvers_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+    let solver = <Solver as schemars::JsonSchema>::json_schema(generator);
+    let variants = solver.get("oneOf").and_then(|v| v.as_array());
+    let mut properties = serde_json::Map::new();
+    for s in Solver::ALL {
+        let doc = variants
+            .into_iter()
+            .flatten()
+            .find(|v| v.get("const").and_then(|c| c.as_str()) == Some(s.name()))
+            .and_then(|v| v.get("description"))
+            .and_then(|d| d.as_str())
+            .unwrap_or_default();
+        let description = format!("Path of the base scenario, relative to this file. {doc}");
+        properties.insert(
+            s.name().to_owned(),
+            serde_json::json!({ "type": "string", "description": description }),
+        );
+    }
+    schemars::json_schema!({
+        "type": "object",
+        "properties": properties,
+        "additionalProperties": false,
+        "minProperties": 1,
+    })
+}
+
+/// A value the sweep puts into a base scenario: a number, a string or a boolean, where the base
+/// has the same kind of scalar ([`set_field`]).
+fn scalar_schema() -> serde_json::Value {
+    serde_json::json!({ "type": ["number", "string", "boolean"] })
+}
+
+/// What a key of `[set]` or `[[vary]]` is.
+const PATH_KEY: &str = "The key is a dotted path to a value of the base scenario \
+    (`column.width`), or the same after a solver's name to change that solver's base only \
+    (`dem.grain_contact.friction`); the value must be of the same kind as the base's (a number \
+    for a number, a string for a string, a boolean for a boolean).";
+
+/// `[set]`: dotted path → value.
+fn set_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+    schemars::json_schema!({
+        "type": "object",
+        "additionalProperties": { "description": PATH_KEY, "allOf": [scalar_schema()] },
+    })
+}
+
+/// `[[vary]]`: at least one table of dotted path → non-empty list of values.
+fn vary_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+    schemars::json_schema!({
+        "type": "array",
+        "minItems": 1,
+        "items": {
+            "type": "object",
+            "minProperties": 1,
+            "additionalProperties": {
+                "description": format!("{PATH_KEY} The lists of one table have the same length: \
+                    case k takes the k-th value of each."),
+                "type": "array",
+                "minItems": 1,
+                "items": scalar_schema(),
+            },
+        },
+    })
 }
 
 /// One case: a solver and its resolved scenario.

@@ -71,7 +71,9 @@ use crate::{Error, Result};
 mod transfer;
 
 /// Update scheme (order of stress update and momentum update).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum Scheme {
     /// Update stress first (from the velocities mapped at the start of the step).
@@ -159,7 +161,9 @@ impl MpmEnergy {
 }
 
 /// Velocity transfer between points and grid.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum Transfer {
     /// FLIP, blended with PIC by [`MpmParams::pic_fraction`].

@@ -27,7 +27,7 @@ use crate::scenario::{non_negative, positive, Kind, ScenarioFile};
 use crate::{Error, Result};
 
 /// A DEM column-collapse scenario, as read from TOML. All values SI.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DemScenario {
     /// `"dem"`: what the file describes.
@@ -58,7 +58,7 @@ pub struct DemScenario {
 }
 
 /// Grain sizes and material.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GrainsSpec {
     /// Smallest diameter d_min (m).
@@ -74,7 +74,7 @@ pub struct GrainsSpec {
 }
 
 /// Diameter distribution, see [`SizeDistribution`].
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Distribution {
     /// Uniform in number.
@@ -84,7 +84,7 @@ pub enum Distribution {
 }
 
 /// Column and box.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ColumnGeometry {
     /// Initial width L_i (m).
@@ -98,7 +98,7 @@ pub struct ColumnGeometry {
 }
 
 /// One contact law (see [`ContactParams`]).
-#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
     /// Normal stiffness k_n (N/m).
@@ -135,7 +135,7 @@ impl ContactSpec {
 }
 
 /// Deposition of the initial column.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DepositionSpec {
     /// Grain–grain friction during deposition: 0 gives a dense column, ≈ the grain value a
@@ -160,7 +160,7 @@ pub struct DepositionSpec {
 }
 
 /// Time stepping, outputs, stop.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DemTimeSpec {
     /// Safety factor λ of seed eq. 5.60 (Δt = λ Δt_cr); at most 0.1 is advised.

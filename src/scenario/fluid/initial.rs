@@ -65,8 +65,31 @@ impl<'de> Deserialize<'de> for FieldValue {
     }
 }
 
+/// What the hand-written [`Deserialize`] above accepts: a number (an integer too) or a string.
+impl schemars::JsonSchema for FieldValue {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "FieldValue".into()
+    }
+
+    fn json_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        schemars::json_schema!({
+            "description": "A number, or an expression of x and y (m) in quotes, e.g. \"0.1*sin(x)\".",
+            "anyOf": [
+                { "type": "number", "description": "The same value everywhere." },
+                {
+                    "type": "string",
+                    "description": "An expression of x and y in m: numbers, `+ - * / ^`, \
+                        parentheses, `PI`, `E` and the functions sin, cos, tan, asin, acos, \
+                        atan, sinh, cosh, tanh, exp, ln, log, sqrt, cbrt, abs, signum, min, \
+                        max, floor, ceil, round."
+                }
+            ]
+        })
+    }
+}
+
 /// Initial state: velocity (m/s) and gauge pressure (Pa), each uniform or a field.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
     /// Initial velocity (u, v) in m/s, each a number or an expression of x, y.

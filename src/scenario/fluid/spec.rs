@@ -10,7 +10,7 @@ use crate::units::{Units, CS2};
 use crate::{Error, Result};
 
 /// A fluid scenario, as read from TOML. All values SI.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Scenario {
     /// `"fluid"`: what the file describes.
@@ -51,7 +51,7 @@ impl ScenarioFile for Scenario {
 }
 
 /// Fluid properties.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FluidSpec {
     /// Density ρ in kg/m³.
@@ -61,7 +61,7 @@ pub struct FluidSpec {
 }
 
 /// Domain [0, size_x] × [0, size_y] divided into square cells of side dx.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DomainSpec {
     /// Size in metres; each must be a whole number of cells.
@@ -71,7 +71,7 @@ pub struct DomainSpec {
 }
 
 /// Time stepping. Give exactly one of `tau` or `dt`.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TimeSpec {
     /// Relaxation time τ (> ½); sets Δt = (τ − ½) Δx²/(3ν).
@@ -87,7 +87,7 @@ pub struct TimeSpec {
 }
 
 /// Collision operator.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, schemars::JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum CollisionKind {
     /// Single relaxation time.
@@ -97,7 +97,7 @@ pub enum CollisionKind {
 }
 
 /// Floating-point precision of the populations.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, schemars::JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum Precision {
     /// 4-byte floats: half the memory traffic.
@@ -107,7 +107,7 @@ pub enum Precision {
 }
 
 /// Numerical method.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LbmSpec {
     /// `"bgk"` or `"mrt"`.
@@ -121,7 +121,7 @@ pub struct LbmSpec {
 }
 
 /// MRT relaxation rates, each in (0, 2).
-#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MrtSpec {
     /// Energy moment.
@@ -174,7 +174,7 @@ impl MrtSpec {
 }
 
 /// Edge conditions.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BoundarySpec {
     /// x = 0.
@@ -188,7 +188,7 @@ pub struct BoundarySpec {
 }
 
 /// Velocity profile along a Zou–He velocity edge.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, schemars::JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum Profile {
     /// The same velocity on every node.
@@ -198,7 +198,7 @@ pub enum Profile {
 }
 
 /// One edge condition.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum EdgeSpec {
     /// Wraps to the opposite edge.
@@ -225,7 +225,7 @@ pub enum EdgeSpec {
 }
 
 /// Reference scales.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ReferenceSpec {
     /// Characteristic (largest expected) speed U in m/s: sets the Mach check and Re = UL/ν.
@@ -235,7 +235,7 @@ pub struct ReferenceSpec {
 }
 
 /// A solid obstacle.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ObstacleSpec {
     /// Disk.
@@ -272,7 +272,7 @@ pub enum ObstacleSpec {
 }
 
 /// A point probe.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ProbeSpec {
     /// Name in the time-series header.

@@ -31,7 +31,7 @@ use crate::scenario::{non_negative, positive, Kind, ScenarioFile};
 use crate::{Error, Result};
 
 /// An MPM column-collapse scenario, as read from TOML. All values SI (angles in degrees).
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MpmScenario {
     /// `"mpm"`: what the file describes.
@@ -58,7 +58,7 @@ pub struct MpmScenario {
 }
 
 /// Constitutive law, chosen by `model`.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
 pub enum MaterialSpec {
     /// Linear isotropic elasticity.
@@ -173,7 +173,7 @@ impl Volume {
 }
 
 /// Column and box.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MpmColumn {
     /// Initial width L_i (m).
@@ -185,7 +185,7 @@ pub struct MpmColumn {
 }
 
 /// Discretisation.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MpmSpec {
     /// Cell size h (m).
@@ -211,7 +211,7 @@ pub struct MpmSpec {
 }
 
 /// Conditions of the three walls.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WallsSpec {
     /// Floor y = 0.
@@ -223,7 +223,7 @@ pub struct WallsSpec {
 }
 
 /// Time stepping, outputs, stop.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MpmTimeSpec {
     /// Time step (s); omitted: C h/c. A larger one than C h/c is refused.

@@ -34,7 +34,7 @@ use crate::units::{Units, CS2};
 use crate::{Error, Result};
 
 /// A submerged column collapse, as read from TOML. All values SI.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SubmergedScenario {
     /// `"submerged"`: what the file describes.
@@ -69,7 +69,7 @@ pub struct SubmergedScenario {
 }
 
 /// The liquid filling the tank.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LiquidSpec {
     /// Density ρ_f (kg/m³); must be below the grain density.
@@ -82,7 +82,7 @@ pub struct LiquidSpec {
 }
 
 /// How grains and fluid exchange momentum.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, schemars::JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum CouplingMethod {
     /// Partially saturated cells (Noble & Torczynski 1998, seed eq. 5.50–5.54).
@@ -94,10 +94,10 @@ pub enum CouplingMethod {
 }
 
 /// Coupling and lattice parameters.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CouplingSpec {
-    /// `"psm"`.
+    /// `"psm"` or `"ladd"`.
     pub method: CouplingMethod,
     /// Hydrodynamic radius factor κ = r/R ∈ (0, 1] (0.7–0.95 in the thesis).
     pub radius_factor: f64,

@@ -162,6 +162,39 @@ impl Grains {
         p
     }
 
+    /// Keep the grains whose entry of `keep` is true, in their order (the polygon table is
+    /// unchanged). `keep` has one entry per grain.
+    pub fn retain(&mut self, keep: &[bool]) {
+        fn compact<T: Copy>(v: &mut Vec<T>, keep: &[bool]) {
+            let mut k = 0;
+            for i in 0..v.len() {
+                if keep[i] {
+                    v[k] = v[i];
+                    k += 1;
+                }
+            }
+            v.truncate(k);
+        }
+        assert_eq!(keep.len(), self.len(), "one keep flag per grain");
+        for v in [
+            &mut self.x,
+            &mut self.y,
+            &mut self.vx,
+            &mut self.vy,
+            &mut self.angle,
+            &mut self.omega,
+            &mut self.radius,
+            &mut self.mass,
+            &mut self.inertia,
+            &mut self.fx,
+            &mut self.fy,
+            &mut self.torque,
+        ] {
+            compact(v, keep);
+        }
+        compact(&mut self.shape, keep);
+    }
+
     /// Total grain area: Σ π R² over disks plus the polygons' areas.
     pub fn area(&self) -> f64 {
         (0..self.len())

@@ -46,6 +46,7 @@ use super::walls::Wall;
 use crate::{Error, Result};
 
 mod forces;
+mod remove;
 
 use forces::{chunks, Drift, JForce};
 

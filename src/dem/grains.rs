@@ -165,16 +165,6 @@ impl Grains {
     /// Keep the grains whose entry of `keep` is true, in their order (the polygon table is
     /// unchanged). `keep` has one entry per grain.
     pub fn retain(&mut self, keep: &[bool]) {
-        fn compact<T: Copy>(v: &mut Vec<T>, keep: &[bool]) {
-            let mut k = 0;
-            for i in 0..v.len() {
-                if keep[i] {
-                    v[k] = v[i];
-                    k += 1;
-                }
-            }
-            v.truncate(k);
-        }
         assert_eq!(keep.len(), self.len(), "one keep flag per grain");
         for v in [
             &mut self.x,
@@ -207,4 +197,16 @@ impl Grains {
             })
             .sum()
     }
+}
+
+/// Keep the entries of `v` whose flag in `keep` is true, in order.
+pub(crate) fn compact<T: Copy>(v: &mut Vec<T>, keep: &[bool]) {
+    let mut k = 0;
+    for i in 0..v.len() {
+        if keep[i] {
+            v[k] = v[i];
+            k += 1;
+        }
+    }
+    v.truncate(k);
 }

@@ -51,14 +51,7 @@ impl Dem {
             &mut self.wp,
         ] {
             if v.len() == n {
-                let mut k = 0;
-                for i in 0..n {
-                    if keep[i] {
-                        v[k] = v[i];
-                        k += 1;
-                    }
-                }
-                v.truncate(k);
+                crate::dem::grains::compact(v, &keep);
             }
         }
         // Both lists stay sorted: the renumbering keeps the order of the grains left.

@@ -345,7 +345,9 @@ fn run_resumable<'a>(
         Kind::Granular => {
             let s = GranularScenario::from_text(text, path)?;
             let d = s.derive()?;
-            let dir = take(granflow::scenario::granular::granular_memory(d.grains.len()))?;
+            let dir = take(granflow::scenario::granular::granular_memory(
+                d.grains.len(),
+            ))?;
             eprintln!(
                 "{}: granular, {} grains, {} walls, {} outlet(s) -> {}",
                 s.name,

@@ -53,6 +53,8 @@ pub struct GranularSummary {
     pub discharged_mass: f64,
     /// Mass at the release (kg).
     pub mass_at_release: f64,
+    /// Mass left at the end (kg): `mass_at_release − discharged_mass` to round-off.
+    pub mass_at_end: f64,
     /// Discharge rate W (kg/s) over the window of [`RATE_WINDOW`], if reached.
     pub discharge_rate: Option<f64>,
     /// Simulated settling time before the release (s), if the scenario settles.
@@ -127,17 +129,25 @@ fn advance(dem: &mut Dem, outlets: &[[[f64; 2]; 2]], steps: u64) -> Result<(u64,
 /// Kinetic energy, translational and rotational (J).
 fn kinetic(g: &Grains) -> f64 {
     (0..g.len())
-        .map(|i| 0.5 * (g.mass[i] * (g.vx[i] * g.vx[i] + g.vy[i] * g.vy[i]) + g.inertia[i] * g.omega[i] * g.omega[i]))
+        .map(|i| {
+            0.5 * (g.mass[i] * (g.vx[i] * g.vx[i] + g.vy[i] * g.vy[i])
+                + g.inertia[i] * g.omega[i] * g.omega[i])
+        })
         .sum()
 }
 
 /// Settle the grains behind every wall and gate until at rest (see the module of the spec);
 /// the grains at rest and the simulated time taken.
-fn settle(s: &GranularScenario, d: &DerivedGranular) -> Result<(Grains, f64)> {
+pub(super) fn settle(s: &GranularScenario, d: &DerivedGranular) -> Result<(Grains, f64)> {
     let Some(spec) = s.settle else {
         return Ok((d.grains.clone(), 0.0));
     };
-    let walls: Vec<_> = d.walls.iter().map(|(w, _)| *w).chain(d.gates.iter().copied()).collect();
+    let walls: Vec<_> = d
+        .walls
+        .iter()
+        .map(|(w, _)| *w)
+        .chain(d.gates.iter().copied())
+        .collect();
     let mut dem = Dem::new(d.grains.clone(), walls, d.params.clone())?;
     let g_abs = s.gravity[0].hypot(s.gravity[1]);
     let chunk = 200;
@@ -176,7 +186,7 @@ fn settle(s: &GranularScenario, d: &DerivedGranular) -> Result<(Grains, f64)> {
 }
 
 /// The released system: the settled grains, the walls that stay, moving ones set going.
-fn release(d: &DerivedGranular, grains: Grains) -> Result<Dem> {
+pub(super) fn release(d: &DerivedGranular, grains: Grains) -> Result<Dem> {
     let walls = d.walls.iter().map(|(w, _)| *w).collect();
     let mut dem = Dem::new(grains, walls, d.params.clone())?;
     for (k, (_, v)) in d.walls.iter().enumerate() {
@@ -185,6 +195,27 @@ fn release(d: &DerivedGranular, grains: Grains) -> Result<Dem> {
         }
     }
     Ok(dem)
+}
+
+/// Discharge a released `dem` through `outlets` without writing anything: (t, discharged
+/// mass) every `interval` s from the release until `fraction` of its mass has left, no grain
+/// is left, or `end` s have passed.
+pub(super) fn discharge(
+    dem: &mut Dem,
+    outlets: &[[[f64; 2]; 2]],
+    interval: f64,
+    fraction: f64,
+    end: f64,
+) -> Result<Vec<(f64, f64)>> {
+    let mass: f64 = dem.grains.mass.iter().sum();
+    let row_steps = ((interval / dem.dt()).ceil() as u64).max(1);
+    let mut history = vec![(dem.time(), 0.0)];
+    let mut discharged = 0.0;
+    while discharged < fraction * mass && !dem.grains.is_empty() && dem.time() < end {
+        discharged += advance(dem, outlets, row_steps)?.1;
+        history.push((dem.time(), discharged));
+    }
+    Ok(history)
 }
 
 /// Run the scenario into `out` as `control` says (checkpoints, stop signals, resume);
@@ -232,7 +263,11 @@ pub fn run_granular(
                 pvd: Vec::new(),
                 wall_time_s: 0.0,
             };
-            (st, CsvWriter::create(&series, &header)?, PvdSeries::new(out))
+            (
+                st,
+                CsvWriter::create(&series, &header)?,
+                PvdSeries::new(out),
+            )
         }
     };
     let dt = st.dem.dt();
@@ -265,7 +300,14 @@ pub fn run_granular(
             let done = empty || drained || t >= s.time.end * (1.0 - 1e-12);
             if (st.row.is_multiple_of(frame_every) || done) && !empty {
                 let c: Vec<f64> = contacts.iter().map(|&c| f64::from(c)).collect();
-                write_frame(&st.dem, &c, thickness, (&s.vtk, out), (st.frame, t), &mut pvd)?;
+                write_frame(
+                    &st.dem,
+                    &c,
+                    thickness,
+                    (&s.vtk, out),
+                    (st.frame, t),
+                    &mut pvd,
+                )?;
                 st.frame += 1;
             }
             st.row += 1;
@@ -308,6 +350,7 @@ pub fn run_granular(
         discharged: st.discharged,
         discharged_mass: st.discharged_mass,
         mass_at_release: st.mass_at_release,
+        mass_at_end: st.dem.grains.mass.iter().sum(),
         discharge_rate: discharge_rate(&st.history, st.mass_at_release),
         settle_time: st.settle_time,
         end_time: st.dem.time(),

@@ -210,7 +210,7 @@ impl GranularScenario {
     /// non-positive sizes, densities or intervals; a wall or region given with none or two
     /// shapes; a degenerate rectangle, segment or polygon; a moving polygon or gate; a lattice
     /// spacing below d_max or a region that holds no site; a listed grain's diameter outside
-    /// [d_min, d_max] or two listed grains overlapping; no grains at all; λ outside (0, 1].
+    /// [d_min, d_max] or a listed grain overlapping another; no grains at all; λ outside (0, 1].
     pub fn derive(&self) -> Result<DerivedGranular> {
         finite("gravity", &self.gravity)?;
         let g = &self.grains;
@@ -432,8 +432,7 @@ impl GranularScenario {
                 walls.push((wall, w.velocity));
             }
         }
-        if walls.iter().any(|(w, _)| !w.is_straight()) && walls.iter().any(|(_, v)| v.is_some())
-        {
+        if walls.iter().any(|(w, _)| !w.is_straight()) && walls.iter().any(|(_, v)| v.is_some()) {
             return Err(Error::config(
                 "wall",
                 "walls can move only when no wall is a polygon (the polygon walls go through the \
@@ -444,15 +443,19 @@ impl GranularScenario {
     }
 }
 
-/// Refuse two listed grains (from index `first` on) that overlap.
+/// Refuse a listed grain (index `first` on) that overlaps another grain, listed or filled.
 fn check_listed_apart(g: &Grains, first: usize) -> Result<()> {
     for i in first..g.len() {
-        for j in first..i {
+        for j in 0..i {
             let d = (g.x[i] - g.x[j]).hypot(g.y[i] - g.y[j]);
             if d < g.radius[i] + g.radius[j] {
+                let other = match j.checked_sub(first) {
+                    Some(k) => format!("grain[{k}]"),
+                    None => "a grain of the [[fill]] regions".into(),
+                };
                 return Err(Error::config(
                     format!("grain[{}]", i - first),
-                    format!("overlaps grain[{}]", j - first),
+                    format!("overlaps {other}"),
                 ));
             }
         }
@@ -506,7 +509,8 @@ fn edge_distance(v: &[[f64; 2]], p: [f64; 2]) -> f64 {
         .map(|k| {
             let (a, b) = (v[k], v[(k + 1) % n]);
             let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
-            let t = (((p[0] - a[0]) * ex + (p[1] - a[1]) * ey) / (ex * ex + ey * ey)).clamp(0.0, 1.0);
+            let t =
+                (((p[0] - a[0]) * ex + (p[1] - a[1]) * ey) / (ex * ex + ey * ey)).clamp(0.0, 1.0);
             (a[0] + t * ex - p[0]).hypot(a[1] + t * ey - p[1])
         })
         .fold(f64::INFINITY, f64::min)

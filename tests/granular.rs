@@ -11,60 +11,11 @@ use granflow::scenario::ScenarioFile;
 
 /// A silo 40 mm wide of 4–6 mm grains (soft contacts) with a 20 mm orifice: ≈ 40 grains.
 fn small_silo() -> String {
-    r#"
-kind = "granular"
-name = "small-silo"
-description = "test"
-gravity = [0.0, -9.81]
-seed = 3
-[grains]
-d_min = 4.0e-3
-d_max = 6.0e-3
-distribution = "uniform_by_volume"
-density = 2500.0
-thickness = 5.0e-3
-[grain_contact]
-k_n = 2.0e3
-k_t = 2.0e3
-restitution = 0.5
-friction = 0.3
-rolling_stiffness = 0.0
-rolling_damping = 0.0
-rolling_friction = 0.0
-[wall_contact]
-k_n = 2.0e3
-k_t = 2.0e3
-restitution = 0.5
-friction = 0.3
-rolling_stiffness = 0.0
-rolling_damping = 0.0
-rolling_friction = 0.0
-[[fill]]
-rectangle = [[0.0, 0.0], [0.040, 0.060]]
-spacing = 6.5e-3
-[[wall]]
-plane = { point = [0.0, 0.0], normal = [1.0, 0.0] }
-[[wall]]
-plane = { point = [0.040, 0.0], normal = [-1.0, 0.0] }
-[[wall]]
-segment = [[0.0, 0.0], [0.010, 0.0]]
-[[wall]]
-segment = [[0.030, 0.0], [0.040, 0.0]]
-[[wall]]
-segment = [[0.010, 0.0], [0.030, 0.0]]
-gate = true
-[[outlet]]
-rectangle = [[-1.0, -1.0], [1.0, -0.010]]
-[settle]
-rest_fraction = 1.0e-3
-max_time = 2.0
-[time]
-lambda = 0.1
-end = 1.0
-frame_interval = 0.1
-series_interval = 0.01
-"#
-    .to_string()
+    std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/small_silo.toml"
+    ))
+    .unwrap()
 }
 
 fn parse(text: &str) -> GranularScenario {

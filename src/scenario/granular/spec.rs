@@ -22,6 +22,10 @@ use crate::scenario::dem::spec::{ContactSpec, GrainsSpec};
 use crate::scenario::{positive, Kind, ScenarioFile};
 use crate::{Error, Result};
 
+/// Most lattice sites a `[[fill]]` region may span (a guard against a spacing or region off by
+/// orders of magnitude; at ≈ 2 KiB per grain, 10⁷ grains take ≈ 20 GiB).
+const MAX_SITES: f64 = 1e7;
+
 /// A granular scenario of any geometry, as read from TOML. All values SI.
 #[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -352,6 +356,16 @@ impl GranularScenario {
         };
         let (lo, hi) = bounds(&vertices);
         let s = f.spacing;
+        let sites = ((hi[0] - lo[0]) / s) * ((hi[1] - lo[1]) / s);
+        if sites > MAX_SITES {
+            return Err(Error::config(
+                format!("{field}.spacing"),
+                format!(
+                    "the region spans about {sites:.3e} lattice sites of spacing {s} m, more than \
+                     the {MAX_SITES:.0e} grains a scenario may hold"
+                ),
+            ));
+        }
         let before = grains.len();
         let mut y = lo[1] + 0.5 * s;
         while y <= hi[1] - 0.5 * s {

@@ -218,16 +218,7 @@ impl GranularScenario {
     pub fn derive(&self) -> Result<DerivedGranular> {
         finite("gravity", &self.gravity)?;
         let g = &self.grains;
-        positive("grains.d_min", g.d_min)?;
-        positive("grains.d_max", g.d_max)?;
-        positive("grains.density", g.density)?;
-        positive("grains.thickness", g.thickness)?;
-        if g.d_max < g.d_min {
-            return Err(Error::config(
-                "grains.d_max",
-                format!("must be ≥ d_min = {}, got {}", g.d_min, g.d_max),
-            ));
-        }
+        g.check()?;
         let rho = g.density * g.thickness;
         let mut grains = Grains::new();
         let mut rng = SplitMix64::new(self.seed);

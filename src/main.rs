@@ -200,6 +200,8 @@ enum SchemaKind {
     Mpm,
     /// A submerged (LBM–DEM) column collapse.
     Submerged,
+    /// A DEM problem of any geometry (regions, walls, gates, outlets).
+    Granular,
     /// A study over many collapse scenarios.
     Sweep,
     /// Every kind (with --markdown only).
@@ -215,6 +217,7 @@ impl SchemaKind {
             SchemaKind::Dem => Some(Kind::Dem),
             SchemaKind::Mpm => Some(Kind::Mpm),
             SchemaKind::Submerged => Some(Kind::Submerged),
+            SchemaKind::Granular => Some(Kind::Granular),
             SchemaKind::Sweep => Some(Kind::Sweep),
             SchemaKind::All => None,
         }

@@ -22,6 +22,7 @@ use toml::Value;
 
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::fluid::Scenario;
+use granflow::scenario::granular::GranularScenario;
 use granflow::scenario::mpm::MpmScenario;
 use granflow::scenario::submerged::SubmergedScenario;
 use granflow::scenario::{kind_of, Kind, ScenarioFile};
@@ -72,6 +73,9 @@ fn check(text: &str) -> granflow::Result<()> {
             d.memory_bytes();
         }),
         Kind::Submerged => SubmergedScenario::from_toml(text)?
+            .check_report()
+            .map(|_| ()),
+        Kind::Granular => GranularScenario::from_toml(text)?
             .check_report()
             .map(|_| ()),
         Kind::Sweep => {

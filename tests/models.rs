@@ -5,6 +5,7 @@ use std::path::Path;
 
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::fluid::Scenario;
+use granflow::scenario::granular::GranularScenario;
 use granflow::scenario::mpm::MpmScenario;
 use granflow::scenario::submerged::SubmergedScenario;
 use granflow::scenario::{kind_of_file, Kind, ScenarioFile};
@@ -55,6 +56,9 @@ fn every_model_file_declares_its_kind_and_checks_as_it() {
                 .and_then(|s| s.derive())
                 .map(|_| ()),
             Kind::Submerged => SubmergedScenario::from_file(f)
+                .and_then(|s| s.derive())
+                .map(|_| ()),
+            Kind::Granular => GranularScenario::from_file(f)
                 .and_then(|s| s.derive())
                 .map(|_| ()),
             // Every case of a sweep (its base with the sweep's keys set) checks as its kind.

@@ -13,6 +13,8 @@ use granflow::scenario::collapse::dem::run_resumable_collapse;
 use granflow::scenario::collapse::mpm::run_column_collapse_with;
 use granflow::scenario::collapse::submerged::run_submerged;
 use granflow::scenario::dem::DemScenario;
+use granflow::scenario::granular::run::run_granular;
+use granflow::scenario::granular::GranularScenario;
 use granflow::scenario::mpm::spec::MaterialSpec;
 use granflow::scenario::mpm::MpmScenario;
 use granflow::scenario::submerged::SubmergedScenario;
@@ -314,6 +316,15 @@ fn a_dem_collapse_stopped_or_killed_part_way_resumes_to_the_uninterrupted_result
     let s = DemScenario::from_toml(&text).unwrap();
     stopped_and_killed_runs_resume_to_the_uninterrupted_result(&text, 0.02, |c, dir, p| {
         run_resumable_collapse(&s, dir, c, p).map(|_| ())
+    });
+}
+
+#[test]
+fn a_silo_discharge_stopped_or_killed_part_way_resumes_to_the_uninterrupted_result() {
+    let text = std::fs::read_to_string(data("small_silo.toml")).unwrap();
+    let s = GranularScenario::from_toml(&text).unwrap();
+    stopped_and_killed_runs_resume_to_the_uninterrupted_result(&text, 0.02, |c, dir, p| {
+        run_granular(&s, dir, c, p).map(|_| ())
     });
 }
 

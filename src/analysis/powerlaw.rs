@@ -168,6 +168,28 @@ pub fn fit_runout(a: &[f64], dl: &[f64]) -> Option<RunoutLaw> {
     best.map(|b| b.2)
 }
 
+/// The straight line y ≈ s x + c by least squares (at least two distinct x): (s, c).
+pub fn linear_fit(x: &[f64], y: &[f64]) -> (f64, f64) {
+    let (b, _, _) = least_squares(&[x.to_vec(), vec![1.0; x.len()]], y);
+    (b[0], b[1])
+}
+
+/// y = λ (x − k)^α with λ, α and the shift k all free, as for Beverloo's law W ∝ (D − k d)^α:
+/// for each trial k of `shifts` (each below the smallest x) the power law is fitted in log
+/// space ([`fit_free`] on x − k), and the k with the least squared residual is kept. The
+/// errors of λ and α are those of that fit (k held).
+pub fn fit_shifted(x: &[f64], y: &[f64], shifts: &[f64]) -> Option<(f64, PowerLaw)> {
+    let x_min = x.iter().copied().fold(f64::INFINITY, f64::min);
+    shifts
+        .iter()
+        .filter(|&&k| k < x_min)
+        .map(|&k| {
+            let xs: Vec<f64> = x.iter().map(|v| v - k).collect();
+            (k, fit_free(&xs, y))
+        })
+        .min_by(|a, b| a.1.ssr.total_cmp(&b.1.ssr))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -214,5 +236,21 @@ mod tests {
         assert!((law.lambda_err.unwrap() - law.lambda * f64::sqrt(var_ln_l)).abs() < 1e-12);
         // Two points leave no degrees of freedom.
         assert!(fit_free(&[1.0, 2.0], &[1.0, 3.0]).alpha_err.is_none());
+    }
+
+    /// A line and a shifted power law built exactly are found again (to round-off, and to
+    /// the trial grid for the shift).
+    #[test]
+    fn line_and_shifted_power_law_are_recovered() {
+        let x = [1.0, 2.0, 3.0, 5.0];
+        let y: Vec<f64> = x.iter().map(|v| 2.5 * v - 1.0).collect();
+        let (s, c) = linear_fit(&x, &y);
+        assert!((s - 2.5).abs() < 1e-12 && (c + 1.0).abs() < 1e-12);
+        let d = [4.0, 5.0, 6.0, 8.0, 10.0];
+        let w: Vec<f64> = d.iter().map(|v: &f64| 3.0 * (v - 1.5).powf(1.5)).collect();
+        let shifts: Vec<f64> = (0..=40).map(|k| 0.1 * k as f64).collect();
+        let (k, law) = fit_shifted(&d, &w, &shifts).unwrap();
+        assert!((k - 1.5).abs() < 1e-9, "k = {k}");
+        assert!((law.alpha - 1.5).abs() < 1e-9 && (law.lambda - 3.0).abs() < 1e-9);
     }
 }

@@ -9,6 +9,7 @@ use granflow::scenario::checkpointing::{Control, SCENARIO_COPY};
 use granflow::scenario::dem::spec::dem_memory;
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::fluid::Scenario;
+use granflow::scenario::granular::GranularScenario;
 use granflow::scenario::mpm::spec::Law;
 use granflow::scenario::mpm::MpmScenario;
 use granflow::scenario::overrides::Override;
@@ -27,6 +28,11 @@ pub fn check(path: &Path, sets: &[Override]) -> Result<ExitCode> {
         Kind::Mpm => check_mpm(&MpmScenario::from_text(&text, path)?),
         Kind::Submerged => {
             let s = SubmergedScenario::from_text(&text, path)?;
+            print!("{}", s.check_report()?);
+            Ok(ExitCode::SUCCESS)
+        }
+        Kind::Granular => {
+            let s = GranularScenario::from_text(&text, path)?;
             print!("{}", s.check_report()?);
             Ok(ExitCode::SUCCESS)
         }
@@ -335,6 +341,27 @@ fn run_resumable<'a>(
             let s = SubmergedScenario::from_text(text, path)?;
             let dir = take(s.derive()?.memory_bytes)?;
             run_submerged(&s, path, dir, control)
+        }
+        Kind::Granular => {
+            let s = GranularScenario::from_text(text, path)?;
+            let d = s.derive()?;
+            let dir = take(granflow::scenario::granular::granular_memory(
+                d.grains.len(),
+            ))?;
+            eprintln!(
+                "{}: granular, {} grains, {} walls, {} outlet(s) -> {}",
+                s.name,
+                d.grains.len(),
+                d.walls.len() + d.gates.len(),
+                d.outlets.len(),
+                dir.display()
+            );
+            let r = with_progress((1e3 * s.time.end) as u64, "ms", |p| {
+                granflow::scenario::granular::run::run_granular(&s, dir, control, p)
+            })
+            .with_context(|| stopped(path, dir))?;
+            println!("{}", r.done_line());
+            Ok(ExitCode::SUCCESS)
         }
         Kind::Sweep => anyhow::bail!(
             "{} is a sweep file: run it with `granflow sweep {} --out DIR`",

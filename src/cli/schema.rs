@@ -8,6 +8,7 @@ use serde_json::Value;
 
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::fluid::Scenario;
+use granflow::scenario::granular::GranularScenario;
 use granflow::scenario::mpm::MpmScenario;
 use granflow::scenario::schema;
 use granflow::scenario::submerged::SubmergedScenario;
@@ -21,6 +22,7 @@ fn of(kind: Kind) -> Value {
         Kind::Dem => schema::of::<DemScenario>(),
         Kind::Mpm => schema::of::<MpmScenario>(),
         Kind::Submerged => schema::of::<SubmergedScenario>(),
+        Kind::Granular => schema::of::<GranularScenario>(),
         Kind::Sweep => schema::of::<SweepSpec>(),
     }
 }
@@ -34,7 +36,7 @@ pub fn schema(kind: Option<Kind>, markdown: bool) -> Result<ExitCode> {
         (None, true) => schema::document(&Kind::ALL.map(of)),
         (None, false) => anyhow::bail!(
             "`all` is only for --markdown (one reference of every kind); a JSON Schema is of \
-             one kind: name it (fluid, dem, mpm, submerged or sweep)"
+             one kind: name it (fluid, dem, mpm, submerged, granular or sweep)"
         ),
     };
     print!("{text}");

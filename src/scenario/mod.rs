@@ -1,6 +1,6 @@
 //! The scenario storey: what a user writes and runs. Scenario files are TOML in SI units,
 //! `deny_unknown_fields`, with no silent defaults for physical parameters; each says what it
-//! is on its first line, `kind = "fluid" | "dem" | "mpm" | "submerged" | "sweep"`
+//! is on its first line, `kind = "fluid" | "dem" | "mpm" | "submerged" | "granular" | "sweep"`
 //! ([`Kind`]), so a typo gets the error of the kind it is.
 //!
 //! Per kind, a folder holds the file's schema (`spec.rs`: parse, check every value, derive
@@ -12,6 +12,8 @@
 //!   (`granflow biaxial`, `granflow shear`);
 //! * [`mpm`]: the GIMPM column collapse;
 //! * [`submerged`]: the LBM–DEM submerged collapse;
+//! * [`granular`]: DEM problems of any geometry (silo, hopper, chute, obstacles): regions,
+//!   walls, gates and outlets as data;
 //! * [`collapse`]: the one column-collapse runner, for the DEM, MPM and submerged solids;
 //! * [`validation`]: the registry of validation cases (`granflow validate`);
 //! * [`checkpointing`]: checkpoints, resume and the stop signals ask for;
@@ -26,6 +28,7 @@ pub mod checkpointing;
 pub mod collapse;
 pub mod dem;
 pub mod fluid;
+pub mod granular;
 pub mod mpm;
 pub mod overrides;
 pub mod schema;
@@ -51,17 +54,21 @@ pub enum Kind {
     Mpm,
     /// A submerged (LBM–DEM) column collapse ([`submerged::SubmergedScenario`]).
     Submerged,
+    /// A DEM problem of any geometry: regions, walls, gates, outlets
+    /// ([`granular::GranularScenario`]).
+    Granular,
     /// A study over many collapse scenarios ([`crate::sweep::SweepSpec`]).
     Sweep,
 }
 
 impl Kind {
     /// Every kind, in the order the documentation lists them.
-    pub const ALL: [Kind; 5] = [
+    pub const ALL: [Kind; 6] = [
         Kind::Fluid,
         Kind::Dem,
         Kind::Mpm,
         Kind::Submerged,
+        Kind::Granular,
         Kind::Sweep,
     ];
 
@@ -72,6 +79,7 @@ impl Kind {
             Kind::Dem => "dem",
             Kind::Mpm => "mpm",
             Kind::Submerged => "submerged",
+            Kind::Granular => "granular",
             Kind::Sweep => "sweep",
         }
     }
@@ -83,6 +91,8 @@ impl Kind {
             Kind::Sweep
         } else if table.contains_key("coupling") {
             Kind::Submerged
+        } else if table.contains_key("wall") || table.contains_key("fill") {
+            Kind::Granular
         } else if table.contains_key("grains") {
             Kind::Dem
         } else if table.contains_key("material") {

@@ -95,6 +95,11 @@ pub const CASES: &[Case] = &[
         run: |f| checks_only(validation_polygon::polygons(f)),
     },
     Case {
+        name: "silo-beverloo",
+        description: "2-D silo: discharge rate W ∝ (D − k d)^{3/2} over orifice widths 8–16 d",
+        run: super::granular::validation::run,
+    },
+    Case {
         name: "rve-biaxial",
         description: "periodic volume vs wall-bounded biaxial test of one material: φ peak and critical within 2°",
         run: |f| checks_only(super::dem::rve_biaxial::validation(f)),

@@ -173,11 +173,11 @@ pub fn shape(dem: &Dem) -> Shape {
     }
 }
 
-/// Write frame `k` at `time` (grains as part 0, contacts as part 1) into `dir` and list it in
-/// `pvd`.
+/// Write frame `k` at `time` (grains, with their `contacts` counts, as part 0; contacts as
+/// part 1) into `dir` and list it in `pvd`.
 pub fn write_frame(
     dem: &Dem,
-    s: &Shape,
+    contacts: &[f64],
     thickness: f64,
     (format, dir): (&VtkFormat, &Path),
     (k, time): (usize, f64),
@@ -197,7 +197,7 @@ pub fn write_frame(
             Field::scalar("radius", &g.radius),
             Field::vector("velocity", &vel),
             Field::scalar("angular_velocity", &g.omega),
-            Field::scalar("contacts", &s.contacts),
+            Field::scalar("contacts", contacts),
             Field::tensor("stress", &stress),
             Field::scalar("mean_pressure", &pressure),
         ],
@@ -369,7 +369,7 @@ impl Column for DemColumn {
     ) -> Result<()> {
         write_frame(
             &self.dem,
-            &s.shape,
+            &s.shape.contacts,
             self.thickness,
             (format, dir),
             (k, t),

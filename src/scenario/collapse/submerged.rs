@@ -393,7 +393,7 @@ impl<T: Real> Column for SubmergedColumn<'_, T> {
         let sc = self.scenario;
         write_frame(
             &self.coupled.solid,
-            s,
+            &s.contacts,
             sc.grains.thickness,
             (format, dir),
             (k, t),

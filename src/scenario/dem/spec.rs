@@ -73,6 +73,24 @@ pub struct GrainsSpec {
     pub thickness: f64,
 }
 
+impl GrainsSpec {
+    /// Refuse (naming the `grains.` field) a non-positive size, density or thickness and
+    /// d_max < d_min.
+    pub fn check(&self) -> Result<()> {
+        positive("grains.d_min", self.d_min)?;
+        positive("grains.d_max", self.d_max)?;
+        positive("grains.density", self.density)?;
+        positive("grains.thickness", self.thickness)?;
+        if self.d_max < self.d_min {
+            return Err(Error::config(
+                "grains.d_max",
+                format!("must be ≥ d_min = {}, got {}", self.d_min, self.d_max),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Diameter distribution, see [`SizeDistribution`].
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
@@ -216,16 +234,7 @@ impl DemScenario {
     pub fn derive(&self) -> Result<DerivedDem> {
         positive("gravity", self.gravity)?;
         let g = &self.grains;
-        positive("grains.d_min", g.d_min)?;
-        positive("grains.d_max", g.d_max)?;
-        positive("grains.density", g.density)?;
-        positive("grains.thickness", g.thickness)?;
-        if g.d_max < g.d_min {
-            return Err(Error::config(
-                "grains.d_max",
-                format!("must be ≥ d_min = {}, got {}", g.d_min, g.d_max),
-            ));
-        }
+        g.check()?;
         let c = &self.column;
         positive("column.width", c.width)?;
         positive("column.aspect_ratio", c.aspect_ratio)?;

@@ -28,11 +28,18 @@ fn with_progress<R>(total: u64, unit: &str, f: impl FnOnce(&mut dyn FnMut(u64, u
         r
     } else {
         let mut last = 0;
+        let start = std::time::Instant::now();
         f(&mut |i, n| {
             let pct = i * 10 / n.max(1);
             if pct > last {
                 last = pct;
-                eprintln!("{i}/{n} {unit} ({}%)", pct * 10);
+                // The time left if the rest goes at the pace so far.
+                let elapsed = start.elapsed().as_secs_f64();
+                let left = elapsed * (n - i.min(n)) as f64 / i.max(1) as f64;
+                eprintln!(
+                    "{i}/{n} {unit} ({}%), {elapsed:.0} s so far, about {left:.0} s left",
+                    pct * 10
+                );
             }
         })
     }

@@ -219,7 +219,12 @@ pub fn validate(case: &str, json: bool, full: bool, figures: Option<&Path>) -> R
             .with_context(|| format!("cannot create the figures folder {}", dir.display()))?;
     }
     let mut failed = 0;
-    for name in names {
+    let (start, count) = (std::time::Instant::now(), names.len());
+    for (k, name) in names.into_iter().enumerate() {
+        if count > 1 {
+            let so_far = start.elapsed().as_secs_f64();
+            eprintln!("[{}/{count}] {name} ({so_far:.0} s so far)", k + 1);
+        }
         match validation::run(name, fidelity) {
             Ok(report) => {
                 for c in &report.checks {

@@ -352,6 +352,14 @@ pub(crate) enum Bench {
 }
 
 fn main() -> ExitCode {
+    // Rust ignores SIGPIPE, so printing into a closed pipe (`granflow validate list | head -1`)
+    // panics; the default action ends the process quietly, as other command-line tools do.
+    // SAFETY: called first, before any other thread exists; setting a signal's disposition to
+    // its default has no other effect.
+    #[cfg(unix)]
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     match real_main() {
         Ok(code) => code,
         Err(e) => {

@@ -598,3 +598,19 @@ fn set_changes_keys_as_the_file_would() {
     let pvd = std::fs::read_to_string(out_dir.join("series.pvd")).unwrap();
     assert_eq!(pvd.matches("<DataSet").count(), 3, "{pvd}");
 }
+
+/// Output into a pipe its reader has closed (`granflow schema all --markdown | head -1`) ends
+/// the process quietly, as other command-line tools do: no panic message.
+#[test]
+fn a_closed_output_pipe_ends_quietly() {
+    let mut child = granflow()
+        .args(["schema", "all", "--markdown"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}

@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 use crate::dem::packing::{SizeDistribution, SplitMix64};
 use crate::dem::{DemParams, Grains, TimeStep, Wall};
 use crate::io::VtkFormat;
+use crate::lbm::obstacle::Shape;
 use crate::scenario::dem::spec::{ContactSpec, GrainsSpec};
 use crate::scenario::{positive, Kind, ScenarioFile};
 use crate::{Error, Result};
@@ -346,6 +347,9 @@ impl GranularScenario {
             }
         };
         let (lo, hi) = bounds(&vertices);
+        let region = Shape::Polygon {
+            vertices: vertices.clone(),
+        };
         let s = f.spacing;
         let sites = ((hi[0] - lo[0]) / s) * ((hi[1] - lo[1]) / s);
         if sites > MAX_SITES {
@@ -362,7 +366,7 @@ impl GranularScenario {
         while y <= hi[1] - 0.5 * s {
             let mut x = lo[0] + 0.5 * s;
             while x <= hi[0] - 0.5 * s {
-                if inside(&vertices, [x, y]) && edge_distance(&vertices, [x, y]) >= 0.5 * s {
+                if region.contains([x, y]) && edge_distance(&vertices, [x, y]) >= 0.5 * s {
                     let d = dist.sample(rng, d_min, d_max);
                     let room = 0.5 * (s - d);
                     let jx = room * (2.0 * rng.uniform() - 1.0);
@@ -490,21 +494,6 @@ fn bounds(v: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
             )
         },
     )
-}
-
-/// Whether `p` is inside the simple polygon `v` (even–odd rule).
-fn inside(v: &[[f64; 2]], p: [f64; 2]) -> bool {
-    let n = v.len();
-    let mut c = false;
-    for k in 0..n {
-        let (a, b) = (v[k], v[(k + n - 1) % n]);
-        if (a[1] > p[1]) != (b[1] > p[1])
-            && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0]
-        {
-            c = !c;
-        }
-    }
-    c
 }
 
 /// Distance from `p` to the nearest edge of the polygon `v`.

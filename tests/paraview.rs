@@ -1,0 +1,206 @@
+//! ParaView, the real client: short runs of every kind that writes frames (fluid, dem, mpm,
+//! submerged), opened by ParaView's own PVD reader through `scripts/paraview/check_run.py`
+//! (every frame read, every array docs/output.md advertises present), and rendered to PNG by
+//! `grains.py`, `fluid.py` and `points.py`.
+//!
+//! Needs `pvpython` (Debian's `python3-paraview`) and, for rendering without a display,
+//! `xvfb-run` (Debian's `xvfb`). Without them the tests say so and pass; CI installs both and
+//! sets `GRANFLOW_REQUIRE_PARAVIEW=1`, which turns a missing ParaView into a failure.
+//!
+//! Set `GRANFLOW_KEEP_PARAVIEW=<dir>` to keep the rendered PNGs.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Whether ParaView's Python is here; panics when CI requires it and it is not.
+fn paraview_found() -> bool {
+    let found = Command::new("pvpython")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !found {
+        assert!(
+            std::env::var_os("GRANFLOW_REQUIRE_PARAVIEW").is_none(),
+            "GRANFLOW_REQUIRE_PARAVIEW is set but `pvpython` cannot be run (Debian: python3-paraview)"
+        );
+        eprintln!("pvpython not found: the ParaView checks are skipped");
+    }
+    found
+}
+
+/// `pvpython scripts/paraview/SCRIPT ARGS…`, under `xvfb-run -a` where it exists (ParaView's
+/// Debian build renders through X).
+fn pvpython(script: &str, args: &[&Path], extra: &[&str]) -> Output {
+    let xvfb = Command::new("xvfb-run").arg("--help").output().is_ok();
+    let mut cmd = if xvfb {
+        let mut c = Command::new("xvfb-run");
+        c.args(["-a", "pvpython"]);
+        c
+    } else {
+        Command::new("pvpython")
+    };
+    cmd.arg(root().join("scripts/paraview").join(script))
+        .args(args)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+fn ok(what: &str, out: &Output) -> String {
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.status.success(), "{what} failed:\n{text}");
+    text
+}
+
+/// `granflow run SCENARIO --out DIR --set …` into a new folder under `tmp`.
+fn run(tmp: &Path, name: &str, scenario: &str, sets: &[&str]) -> PathBuf {
+    let dir = tmp.join(name);
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_granflow"));
+    cmd.arg("run")
+        .arg(root().join(scenario))
+        .arg("--out")
+        .arg(&dir);
+    for s in sets {
+        cmd.args(["--set", s]);
+    }
+    ok(&format!("granflow run {scenario}"), &cmd.output().unwrap());
+    dir
+}
+
+/// Check the run with ParaView, render it with `script`, and check the PNG.
+fn check_and_render(run: &Path, script: &str, extra: &[&str]) {
+    let text = ok("check_run.py", &pvpython("check_run.py", &[run], &[]));
+    assert!(text.contains("every advertised array present"), "{text}");
+    let png = run.join(format!("{}.png", script.trim_end_matches(".py")));
+    ok(script, &pvpython(script, &[run, &png], extra));
+    let bytes = std::fs::read(&png).unwrap();
+    assert!(
+        bytes.starts_with(b"\x89PNG\r\n\x1a\n") && bytes.len() > 10_000,
+        "{}: not a rendered PNG ({} bytes)",
+        png.display(),
+        bytes.len()
+    );
+    if let Some(keep) = std::env::var_os("GRANFLOW_KEEP_PARAVIEW") {
+        let kind = run.file_name().unwrap().to_string_lossy();
+        std::fs::create_dir_all(&keep).unwrap();
+        std::fs::copy(&png, Path::new(&keep).join(format!("{kind}-{script}.png"))).unwrap();
+    }
+}
+
+#[test]
+fn paraview_reads_and_renders_every_kind() {
+    if !paraview_found() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let t = tmp.path();
+
+    let dem = run(t, "dem", "tests/data/resume_dem.toml", &[]);
+    check_and_render(&dem, "grains.py", &["--time", "0.15"]);
+
+    let submerged = run(
+        t,
+        "submerged",
+        "models/submerged/dense_a0.8.toml",
+        &[
+            "column.width=0.012",
+            "column.box_length=0.048",
+            "fluid.depth=0.016",
+            "time.end_tc=1",
+        ],
+    );
+    check_and_render(&submerged, "grains.py", &[]);
+    check_and_render(&submerged, "fluid.py", &["--field", "pressure"]);
+
+    let fluid = run(
+        t,
+        "fluid",
+        "models/lbm/cylinder_2d1.toml",
+        &["time.end=0.5", "time.frame_interval=0.25"],
+    );
+    check_and_render(&fluid, "fluid.py", &["--field", "vorticity"]);
+
+    let mpm = run(
+        t,
+        "mpm",
+        "models/column_collapse/mpm_a0.5.toml",
+        &["time.end_tc=1", "mpm.points_per_cell=2"],
+    );
+    check_and_render(&mpm, "points.py", &["--field", "mean_stress"]);
+}
+
+/// The check can fail: a fluid run's frames, labelled as a DEM run, lack the grains' arrays.
+#[test]
+fn a_run_without_the_advertised_arrays_is_refused() {
+    if !paraview_found() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let fluid = run(
+        tmp.path(),
+        "fluid",
+        "models/lbm/cylinder_2d1.toml",
+        &["time.end=0.01", "time.frame_interval=0.01"],
+    );
+    let scenario = fluid.join("scenario.toml");
+    let text = std::fs::read_to_string(&scenario).unwrap();
+    std::fs::write(
+        &scenario,
+        text.replacen("kind = \"fluid\"", "kind = \"dem\"", 1),
+    )
+    .unwrap();
+    let out = pvpython("check_run.py", &[&fluid], &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "the mislabelled run passed: {err}");
+    assert!(
+        err.contains("part 0 (grains): point arrays") && err.contains("radius"),
+        "{err}"
+    );
+}
+
+/// The scripts' table of advertised arrays names only arrays docs/output.md documents.
+#[test]
+fn the_scripts_check_the_documented_arrays() {
+    let table = std::fs::read_to_string(root().join("scripts/paraview/granflow_pv.py")).unwrap();
+    let docs = std::fs::read_to_string(root().join("docs/output.md")).unwrap();
+    let start = table.find("GRAINS = [").unwrap();
+    let end = table.find("def fail(").unwrap();
+    let names: Vec<&str> = table[start..end]
+        .split('"')
+        .skip(1)
+        .step_by(2)
+        // The quoted words of the table are kinds, part prefixes, data locations and arrays;
+        // only the arrays are output names.
+        .filter(|n| {
+            ![
+                "point",
+                "cell",
+                "fluid",
+                "dem",
+                "granular",
+                "submerged",
+                "mpm",
+                "grains",
+                "contacts",
+                "points",
+                "grid",
+            ]
+            .contains(n)
+        })
+        .collect();
+    assert!(names.len() > 20, "{names:?}");
+    for n in names {
+        assert!(
+            docs.contains(&format!("`{n}`")),
+            "`{n}` is not in docs/output.md"
+        );
+    }
+}

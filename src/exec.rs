@@ -9,6 +9,35 @@ use crate::{Error, Result};
 /// thousandths of τ_c, points of a test).
 pub type Progress<'a> = &'a mut dyn FnMut(u64, u64);
 
+/// Progress of a phase whose end cannot be foreseen (settling to rest): [`Heartbeat::due`] is
+/// true once every 15 s of wall time, when the caller prints a line of where it stands.
+pub struct Heartbeat(std::time::Instant);
+
+impl Heartbeat {
+    /// Interval between lines.
+    pub const EVERY: std::time::Duration = std::time::Duration::from_secs(15);
+
+    /// A heartbeat whose first line is due 15 s from now.
+    pub fn new() -> Self {
+        Heartbeat(std::time::Instant::now())
+    }
+
+    /// Whether a line is due (and, if so, the next one 15 s later).
+    pub fn due(&mut self) -> bool {
+        let due = self.0.elapsed() >= Self::EVERY;
+        if due {
+            self.0 = std::time::Instant::now();
+        }
+        due
+    }
+}
+
+impl Default for Heartbeat {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 /// Median of `v` (sorted in place; the upper one of the middle two for an even count).
 pub fn median(v: &mut [f64]) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));

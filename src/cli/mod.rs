@@ -28,14 +28,17 @@ fn with_progress<R>(total: u64, unit: &str, f: impl FnOnce(&mut dyn FnMut(u64, u
         r
     } else {
         let mut last = 0;
-        let start = std::time::Instant::now();
+        // The pace is measured from the first report, so that a preparation before it (a
+        // deposition) does not count as progress.
+        let mut first: Option<(std::time::Instant, u64)> = None;
         f(&mut |i, n| {
+            let (start, i0) = *first.get_or_insert((std::time::Instant::now(), i));
             let pct = i * 10 / n.max(1);
             if pct > last {
                 last = pct;
                 // The time left if the rest goes at the pace so far.
                 let elapsed = start.elapsed().as_secs_f64();
-                let left = elapsed * (n - i.min(n)) as f64 / i.max(1) as f64;
+                let left = elapsed * (n - i.min(n)) as f64 / (i - i0.min(i)).max(1) as f64;
                 eprintln!(
                     "{i}/{n} {unit} ({}%), {elapsed:.0} s so far, about {left:.0} s left",
                     pct * 10

@@ -159,7 +159,7 @@ pub fn shear(
         s.name,
         out.display()
     );
-    let r = run_mu_i_to(&specs, out)
+    let r = with_progress(1000, "‰ of the shear", |p| run_mu_i_to(&specs, out, p))
         .with_context(|| format!("shear test of {} stopped", path.display()))?;
     for t in &r.tests {
         println!("{}", t.done_line());

@@ -255,14 +255,26 @@ struct Rest {
 }
 
 impl Rest {
-    /// Step `dem` until its kinetic energy is below the limit, not before `min_time`.
+    /// Step `dem` until its kinetic energy is below the limit, not before `min_time`; every
+    /// 15 s of wall time a line on standard error says how far it is (the end is the rest,
+    /// which cannot be foreseen: the line gives the kinetic energy against the limit).
     fn settle(&self, dem: &mut Dem, min_time: f64, stage: &str) -> Result<()> {
         let check = ((self.check_time / dem.dt()).ceil() as u64).max(1);
+        let mut heartbeat = crate::exec::Heartbeat::new();
         while dem.time() < self.max_time {
             dem.steps(check);
             let k = dem.energy().kinetic_total();
             if !k.is_finite() {
                 return Err(Error::Other(format!("{stage} went unstable")));
+            }
+            if heartbeat.due() {
+                eprintln!(
+                    "{stage}: {:.3} s simulated (at most {} s), kinetic energy {:.1} × the rest \
+                     level",
+                    dem.time(),
+                    self.max_time,
+                    k / self.kinetic
+                );
             }
             if dem.time() > min_time && k < self.kinetic {
                 return Ok(());

@@ -16,6 +16,7 @@
 //! mean over the second half of the strain, after the dilatancy transient.
 
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 use serde::Serialize;
@@ -470,14 +471,42 @@ pub struct MuIResult {
 /// Run the tests (in parallel, one per inertial number) and write, into `out_dir`,
 /// `shear_<k>.csv` (the block means of test k), `mu_i.csv` (one row per test), `summary.json`
 /// and `mu_i.svg`. Nothing is written if a test fails.
-pub fn run_mu_i_to(specs: &[ShearSpec], out_dir: &Path) -> Result<MuIResult> {
+///
+/// `progress` gets (‰ done, 1000), called from this thread every 0.2 s: the shear records done
+/// by each test, weighted by the test's share of the shear steps, which goes as 1/I (at a
+/// fixed strain and time step the shear takes γ/(γ̇ Δt) steps, γ̇ = I √(P/ρ)/d; the
+/// preparation, the same for every test, is not counted).
+pub fn run_mu_i_to(
+    specs: &[ShearSpec],
+    out_dir: &Path,
+    progress: crate::exec::Progress,
+) -> Result<MuIResult> {
     for s in specs {
         s.check()?;
     }
-    let mut tests = specs
-        .par_iter()
-        .map(|s| run_shear(s, &mut |_, _| {}))
-        .collect::<Result<Vec<_>>>()?;
+    let share: Vec<f64> = specs.iter().map(|s| 1.0 / s.inertial_number).collect();
+    let per_mille = 1e3 / share.iter().sum::<f64>();
+    let done: Vec<AtomicU64> = specs.iter().map(|_| AtomicU64::new(0)).collect();
+    let mut tests = std::thread::scope(|scope| {
+        let worker = scope.spawn(|| {
+            specs
+                .par_iter()
+                .enumerate()
+                .map(|(k, s)| {
+                    run_shear(s, &mut |i, n| {
+                        let d = per_mille * share[k] * i as f64 / n.max(1) as f64;
+                        done[k].store(d as u64, Ordering::Relaxed);
+                    })
+                })
+                .collect::<Result<Vec<_>>>()
+        });
+        while !worker.is_finished() {
+            progress(done.iter().map(|d| d.load(Ordering::Relaxed)).sum(), 1000);
+            std::thread::sleep(std::time::Duration::from_millis(200));
+        }
+        worker.join().expect("a shear test panicked")
+    })?;
+    progress(1000, 1000);
     tests.sort_by(|a, b| a.inertial_number_p.total_cmp(&b.inertial_number_p));
     let pts: Vec<(f64, f64)> = tests
         .iter()

@@ -151,6 +151,7 @@ pub(super) fn settle(s: &GranularScenario, d: &DerivedGranular) -> Result<(Grain
     let mut dem = Dem::new(d.grains.clone(), walls, d.params.clone())?;
     let g_abs = s.gravity[0].hypot(s.gravity[1]);
     let chunk = 200;
+    let mut heartbeat = crate::exec::Heartbeat::new();
     loop {
         advance(&mut dem, &d.outlets, chunk)?;
         let g = &dem.grains;
@@ -163,8 +164,18 @@ pub(super) fn settle(s: &GranularScenario, d: &DerivedGranular) -> Result<(Grain
         let n = g.len() as f64;
         let m_mean = g.mass.iter().sum::<f64>() / n;
         let d_mean = 2.0 * g.radius.iter().sum::<f64>() / n;
-        if kinetic(g) / n < spec.rest_fraction * m_mean * g_abs * d_mean {
+        let rest = spec.rest_fraction * m_mean * g_abs * d_mean;
+        if kinetic(g) / n < rest {
             break;
+        }
+        if heartbeat.due() {
+            eprintln!(
+                "settling: {:.3} s simulated (at most {} s), kinetic energy {:.1} × the rest \
+                 level",
+                dem.time(),
+                spec.max_time,
+                kinetic(g) / n / rest
+            );
         }
         if dem.time() > spec.max_time {
             return Err(Error::config(
@@ -174,7 +185,7 @@ pub(super) fn settle(s: &GranularScenario, d: &DerivedGranular) -> Result<(Grain
                      rest below {:.3e} J)",
                     spec.max_time,
                     kinetic(g) / n,
-                    spec.rest_fraction * m_mean * g_abs * d_mean
+                    rest
                 ),
             ));
         }

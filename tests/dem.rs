@@ -133,6 +133,7 @@ fn deposition_reproducible_and_packing_fraction() {
         seed: 42,
         rest_fraction: 1e-6,
         max_time: 50.0,
+        sides: None,
     };
     let a = deposit_column(&spec).unwrap();
     let b = deposit_column(&spec).unwrap();
@@ -180,6 +181,7 @@ fn unit_column() -> (DemParams, ColumnSpec) {
         seed: 7,
         rest_fraction: 1e-6,
         max_time: 400.0,
+        sides: None,
     };
     (material, spec)
 }

@@ -131,6 +131,16 @@ fn bad_values_are_refused_with_the_field_named() {
             "[deposition]\nsettling_velocity = 0.0\n",
             "deposition.settling_velocity",
         ),
+        (
+            "thickness = 5.0e-3",
+            "thickness = 5.0e-3\nsides = 2",
+            "grains.sides",
+        ),
+        (
+            "thickness = 5.0e-3",
+            "thickness = 5.0e-3\nsides = 13",
+            "grains.sides",
+        ),
     ] {
         assert!(base.contains(from), "{from}");
         let s = DemScenario::from_toml(&base.replacen(from, to, 1)).unwrap();

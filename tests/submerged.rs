@@ -493,3 +493,13 @@ fn inertial_loose_column_has_positive_and_dense_negative_base_pore_pressure() {
         "dense column: {dense:+.4} of the buoyant weight"
     );
 }
+
+/// Polygon grains (`grains.sides`) are refused in a submerged file, naming the key: the
+/// partially saturated cells cover disks only.
+#[test]
+fn polygon_grains_are_refused() {
+    let mut s = tiny();
+    s.grains.sides = Some(6);
+    let err = s.derive().unwrap_err().to_string();
+    assert!(err.contains("grains.sides"), "{err}");
+}

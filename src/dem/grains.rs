@@ -118,6 +118,25 @@ impl Grains {
         self.shape.get(i).is_none_or(|&s| s == DISK)
     }
 
+    /// Vertices of polygon grain `i` in the world frame, **x**_i + R(θ_i) **v**_k (body-frame
+    /// vertices **v**_k of its shape); empty for a disk.
+    pub fn world_vertices(&self, i: usize) -> Vec<[f64; 2]> {
+        if self.is_disk(i) {
+            return Vec::new();
+        }
+        let (sin, cos) = self.angle[i].sin_cos();
+        self.polygons
+            .vertices(self.shape[i] as usize)
+            .iter()
+            .map(|v| {
+                [
+                    self.x[i] + cos * v[0] - sin * v[1],
+                    self.y[i] + sin * v[0] + cos * v[1],
+                ]
+            })
+            .collect()
+    }
+
     /// Whether some grain is a polygon.
     pub fn has_polygons(&self) -> bool {
         self.shape.iter().any(|&s| s != DISK)

@@ -5,6 +5,7 @@
 use super::contact::ContactParams;
 use super::grains::Grains;
 use super::params::DemParams;
+use super::shape::Polygons;
 use super::solver::Dem;
 use super::walls::Wall;
 use crate::{Error, Result};
@@ -72,10 +73,37 @@ pub fn disk_area_below(r: f64, h: f64) -> f64 {
 pub fn strip_fraction(g: &Grains, x0: f64, x1: f64, y_a: f64, y_b: f64) -> f64 {
     let a: f64 = (0..g.len())
         .map(|i| {
-            disk_area_below(g.radius[i], y_b - g.y[i]) - disk_area_below(g.radius[i], y_a - g.y[i])
+            if g.is_disk(i) {
+                disk_area_below(g.radius[i], y_b - g.y[i])
+                    - disk_area_below(g.radius[i], y_a - g.y[i])
+            } else {
+                let v = g.world_vertices(i);
+                polygon_area_below(&v, y_b) - polygon_area_below(&v, y_a)
+            }
         })
         .sum();
     a / ((x1 - x0) * (y_b - y_a))
+}
+
+/// Area of the part of a convex polygon (vertices in order) below y = `h`: the polygon clipped
+/// by the half-plane y ≤ h (Sutherland–Hodgman: keep the vertices below, add the crossing of
+/// each edge with the line), then the shoelace formula.
+pub fn polygon_area_below(v: &[[f64; 2]], h: f64) -> f64 {
+    let mut clipped = Vec::with_capacity(v.len() + 2);
+    for k in 0..v.len() {
+        let (p, q) = (v[k], v[(k + 1) % v.len()]);
+        if p[1] <= h {
+            clipped.push(p);
+        }
+        if (p[1] - h) * (q[1] - h) < 0.0 {
+            let t = (h - p[1]) / (q[1] - p[1]);
+            clipped.push([p[0] + t * (q[0] - p[0]), h]);
+        }
+    }
+    if clipped.len() < 3 {
+        return 0.0;
+    }
+    crate::dem::shape::polygon_props(&clipped).area.abs()
 }
 
 /// Hexagonal block: `nx` × `ny` sites of a triangular lattice of spacing `spacing`
@@ -142,6 +170,17 @@ pub struct ColumnSpec {
     pub rest_fraction: f64,
     /// Give up after this simulated time (s).
     pub max_time: f64,
+    /// Regular convex polygons of this many sides instead of disks, each of the area of the
+    /// disk of its drawn diameter (circumradius R = (d/2) √(2π / (n sin(2π/n)))) at a random
+    /// orientation; `None`: disks.
+    pub sides: Option<usize>,
+}
+
+/// Circumradius of the regular `n`-gon of the area of a disk of radius `r`: A = (n/2) R²
+/// sin(2π/n) = π r².
+pub fn equal_area_circumradius(n: usize, r: f64) -> f64 {
+    let n = n as f64;
+    r * (2.0 * std::f64::consts::PI / (n * (2.0 * std::f64::consts::PI / n).sin())).sqrt()
 }
 
 /// A deposited column.
@@ -170,7 +209,9 @@ pub fn deposit_column(spec: &ColumnSpec) -> Result<Column> {
             format!("need 0 < d_min ≤ d_max, got {d_min}, {d_max}"),
         ));
     }
-    let pitch = 1.1 * d_max;
+    // Polygons are placed by their circumcircle, so that none overlaps at the start.
+    let bound = spec.sides.map_or(1.0, |n| equal_area_circumradius(n, 1.0));
+    let pitch = 1.1 * d_max * bound;
     let per_row = (spec.width / pitch).floor() as usize;
     if per_row == 0 || spec.grains == 0 {
         return Err(Error::config(
@@ -186,7 +227,18 @@ pub fn deposit_column(spec: &ColumnSpec) -> Result<Column> {
         let jx = 0.05 * d_max * (2.0 * rng.uniform() - 1.0);
         let x =
             spec.x0 + 0.5 * (spec.width - per_row as f64 * pitch) + (col as f64 + 0.5) * pitch + jx;
-        g.push_disk(x, (row as f64 + 0.5) * pitch, 0.5 * d, spec.density);
+        let y = (row as f64 + 0.5) * pitch;
+        match spec.sides {
+            None => {
+                g.push_disk(x, y, 0.5 * d, spec.density);
+            }
+            Some(n) => {
+                let v = Polygons::regular(n, equal_area_circumradius(n, 0.5 * d), 0.0);
+                let s = g.polygons.add(&v, "grains.sides")?;
+                let angle = 2.0 * std::f64::consts::PI * rng.uniform() / n as f64;
+                g.push_polygon(x, y, angle, s, spec.density);
+            }
+        }
     }
     let walls = vec![
         Wall::floor(0.0),
@@ -307,6 +359,36 @@ mod tests {
         let mut r = SplitMix64::new(1234567);
         assert_eq!(r.next_u64(), 6457827717110365317);
         assert_eq!(r.next_u64(), 3203168211198807973);
+    }
+
+    /// The equal-area n-gon: its shoelace area is π r² to round-off for n = 3…12.
+    #[test]
+    fn equal_area_polygon_has_the_disk_area() {
+        for n in 3..=12 {
+            let v = Polygons::regular(n, equal_area_circumradius(n, 0.7), 0.3);
+            let a = crate::dem::shape::polygon_props(&v).area;
+            assert!(
+                (a / (std::f64::consts::PI * 0.49) - 1.0).abs() < 1e-12,
+                "n = {n}: {a}"
+            );
+        }
+    }
+
+    /// Clipping: a unit square [0, 1]² has y·1 below y; a triangle (0,0), (2,0), (0,2) has
+    /// 2 − (2 − h)²/2 below h; all or nothing outside (exact to round-off).
+    #[test]
+    fn polygon_area_below_a_line() {
+        let square = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        for h in [0.1, 0.5, 0.9] {
+            assert!((polygon_area_below(&square, h) - h).abs() < 1e-15);
+        }
+        assert_eq!(polygon_area_below(&square, -0.1), 0.0);
+        assert!((polygon_area_below(&square, 1.5) - 1.0).abs() < 1e-15);
+        let tri = [[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]];
+        for h in [0.3, 1.0, 1.7] {
+            let want = 2.0 - (2.0f64 - h).powi(2) / 2.0;
+            assert!((polygon_area_below(&tri, h) - want).abs() < 1e-14);
+        }
     }
 
     #[test]

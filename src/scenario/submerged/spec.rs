@@ -178,6 +178,13 @@ impl SubmergedScenario {
     /// (0, 1]; a hydrodynamic diameter below 4 cells; neither or both of τ and Δt; τ ≤ ½;
     /// a lattice Mach number above [`MAX_MACH`]; C_s ≤ 0.
     pub fn derive(&self) -> Result<DerivedSubmerged> {
+        if self.grains.sides.is_some() {
+            return Err(Error::config(
+                "grains.sides",
+                "polygon grains are not coupled to the fluid (the partially saturated cells \
+                 cover disks): leave the key out for disks",
+            ));
+        }
         let dem = self.dem_part().derive()?;
         let f = &self.fluid;
         let c = &self.coupling;

@@ -137,6 +137,29 @@ impl Grains {
             .collect()
     }
 
+    /// Area of grain `i` (m², or m² per unit depth): πR² for a disk, its shape's area for a
+    /// polygon.
+    pub fn grain_area(&self, i: usize) -> f64 {
+        if self.is_disk(i) {
+            std::f64::consts::PI * self.radius[i] * self.radius[i]
+        } else {
+            self.polygons.area[self.shape[i] as usize]
+        }
+    }
+
+    /// Largest x and y reached by grain `i`: the centre plus R for a disk, the largest vertex
+    /// coordinates for a polygon.
+    pub fn upper_extent(&self, i: usize) -> [f64; 2] {
+        if self.is_disk(i) {
+            return [self.x[i] + self.radius[i], self.y[i] + self.radius[i]];
+        }
+        self.world_vertices(i)
+            .iter()
+            .fold([f64::NEG_INFINITY; 2], |m, v| {
+                [m[0].max(v[0]), m[1].max(v[1])]
+            })
+    }
+
     /// Whether some grain is a polygon.
     pub fn has_polygons(&self) -> bool {
         self.shape.iter().any(|&s| s != DISK)
@@ -206,15 +229,7 @@ impl Grains {
 
     /// Total grain area: Σ π R² over disks plus the polygons' areas.
     pub fn area(&self) -> f64 {
-        (0..self.len())
-            .map(|i| {
-                if self.is_disk(i) {
-                    std::f64::consts::PI * self.radius[i] * self.radius[i]
-                } else {
-                    self.polygons.area[self.shape[i] as usize]
-                }
-            })
-            .sum()
+        (0..self.len()).map(|i| self.grain_area(i)).sum()
     }
 }
 

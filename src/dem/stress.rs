@@ -1,17 +1,21 @@
-//! Per-grain stress tensor (Love–Weber): for grain i of volume V_i = πR_i² t (t the axial
-//! length of the disks; t = 1 when forces are per unit depth),
+//! Per-grain stress tensor (Love–Weber): for grain i of volume V_i = A_i t (A_i = πR_i² for a
+//! disk, the polygon's area otherwise; t the axial length of the grains, 1 when forces are per
+//! unit depth),
 //!
 //! σ_i = (1/V_i) Σ_c **f**_c ⊗ **l**_c,  σ_ab = (1/V_i) Σ_c f_a l_b,
 //!
 //! summed over its contacts c (grain–grain and grain–wall), with **f**_c the contact force on
 //! grain i (−f_n **n** + f_t **t**, see [`crate::dem::contact`]) and **l**_c the branch vector
 //! from the centre to the contact point, taken in the middle of the overlap:
-//! **l**_c = (R_i − δ/2) **n** (**n** from i towards the partner). Tension is positive, so a
+//! **l**_c = (R_i − δ/2) **n** (**n** from i towards the partner); for a contact found by rapier
+//! (a polygon grain or wall) **l**_c = **p**_c − **x**_i, from the centre to the contact point
+//! (the middle of the overlap, [`crate::dem::detect_rapier`]). Tension is positive, so a
 //! grain squeezed along x has σ_xx < 0. The tensor is symmetric when the grain's contact torques
 //! balance (at rest); in motion the antisymmetric part is the contacts' net torque / V_i.
 //! Summing V_i σ_i over a region and dividing by the region's volume gives the usual
 //! homogenised stress of the packing (the voids contribute nothing).
 
+use super::detect_rapier::WALL_BIT;
 use super::solver::Dem;
 
 /// Love–Weber stress of every grain (Pa), row-major `[xx, xy, yx, yy]`, from the contact
@@ -65,8 +69,25 @@ pub fn grain_stress(dem: &Dem, thickness: f64) -> Vec<[f64; 4]> {
         ];
         add(i, f, [l * n[0], l * n[1]]);
     }
-    for (t, r) in s.iter_mut().zip(&g.radius) {
-        let a = std::f64::consts::PI * r * r * thickness;
+    if let Some(sc) = dem.shape_contacts() {
+        for ((c, st), f) in sc.found.iter().zip(&sc.state).zip(&sc.force) {
+            if !st.touching() {
+                continue;
+            }
+            let i = c.i as usize;
+            add(i, *f, [c.point[0] - g.x[i], c.point[1] - g.y[i]]);
+            if c.j & WALL_BIT == 0 {
+                let j = c.j as usize;
+                add(
+                    j,
+                    [-f[0], -f[1]],
+                    [c.point[0] - g.x[j], c.point[1] - g.y[j]],
+                );
+            }
+        }
+    }
+    for (i, t) in s.iter_mut().enumerate() {
+        let a = g.grain_area(i) * thickness;
         for v in t.iter_mut() {
             *v /= a;
         }
@@ -118,6 +139,42 @@ mod tests {
         let want = -k * delta * (r - 0.5 * delta) / (std::f64::consts::PI * r * r);
         assert_relative_eq!(s[0][3], want, max_relative = 1e-12);
         assert!(s[0][0].abs() + s[0][1].abs() + s[0][2].abs() < 1e-12 * want.abs());
+    }
+
+    /// A square grain of side a pressed flat into the floor by δ (no gravity, at rest): rapier
+    /// reports its two bottom corners, each at the middle of the overlap, y = −δ/2, with the
+    /// floor's push F/2 up; the lever arms are (±a/2, −(a − δ)/2) from the centre, so
+    /// σ_yy = −F (a − δ)/(2a²) on the square's area a², σ_xx = σ_xy = 0 (the x arms cancel).
+    /// F is the force on the grain from the solver, which is 2 k_n δ (one spring per corner).
+    #[test]
+    fn square_on_the_floor() {
+        use crate::dem::shape::Polygons;
+        let (k, a, delta) = (2e5, 0.02, 3e-4);
+        let mut g = Grains::new();
+        let sq = g
+            .polygons
+            .add(
+                &Polygons::regular(4, a / 2f64.sqrt(), std::f64::consts::FRAC_PI_4),
+                "sq",
+            )
+            .unwrap();
+        g.push_polygon(0.5, 0.5 * a - delta, 0.0, sq, 1.0);
+        let law = ContactParams::elastic(k);
+        let mut dem = Dem::new(
+            g,
+            vec![Wall::floor(0.0)],
+            DemParams::new(law, law, [0.0, 0.0]),
+        )
+        .unwrap();
+        dem.refresh_forces();
+        let sc = dem.shape_contacts().unwrap();
+        let f: f64 = sc.force.iter().map(|f| f[1]).sum();
+        assert_eq!(sc.found.len(), 2);
+        assert_relative_eq!(f, 2.0 * k * delta, max_relative = 1e-9);
+        let s = grain_stress(&dem, 1.0);
+        let want = -f * (a - delta) / (2.0 * a * a);
+        assert_relative_eq!(s[0][3], want, max_relative = 1e-9);
+        assert!(s[0][0].abs() + s[0][1].abs() + s[0][2].abs() < 1e-9 * want.abs());
     }
 
     /// Static equilibrium of a frictional heap (with rolling resistance, so it stops) on the

@@ -33,6 +33,7 @@ use serde::Serialize;
 
 use super::{run_resumable, steps_per_row, Column, Plan, Row, Tally};
 use crate::analysis::runout::CollapseOutcome;
+use crate::dem::detect_rapier::WALL_BIT;
 use crate::dem::packing::deposit_column;
 use crate::dem::stress::grain_stress;
 use crate::dem::{Dem, Energy, Wall};
@@ -158,11 +159,11 @@ pub fn shape(dem: &Dem) -> Shape {
     let main = (0..n).max_by_key(|&r| size[r]).unwrap_or(0) as u32;
     let (mut runout, mut front, mut height) = (0.0f64, 0.0f64, 0.0f64);
     for i in 0..n {
-        let right = g.x[i] + g.radius[i];
+        let [right, top] = g.upper_extent(i);
         front = front.max(right);
         if find(&mut parent, i as u32) == main {
             runout = runout.max(right);
-            height = height.max(g.y[i] + g.radius[i]);
+            height = height.max(top);
         }
     }
     Shape {
@@ -227,6 +228,26 @@ pub fn write_frame(
             f_n.push(st.f_n);
             f_t.push(st.f_t);
             wall.push(1.0);
+        }
+    }
+    // Contacts found by rapier (polygon grains or walls), one line per contact point:
+    // f_n = −**f**·**n**, f_t = **f**·**t** of the force **f** on i, **n** the contact normal.
+    if let Some(sc) = dem.shape_contacts() {
+        for ((c, st), f) in sc.found.iter().zip(&sc.state).zip(&sc.force) {
+            if !st.touching() {
+                continue;
+            }
+            let n = c.normal;
+            f_n.push(-(f[0] * n[0] + f[1] * n[1]));
+            f_t.push(-f[0] * n[1] + f[1] * n[0]);
+            if c.j & WALL_BIT == 0 {
+                lines.push([c.i, c.j]);
+                wall.push(0.0);
+            } else {
+                lines.push([c.i, points.len() as u32]);
+                points.push(c.point);
+                wall.push(1.0);
+            }
         }
     }
     let cname = format!("contacts_{k:06}.vtu");

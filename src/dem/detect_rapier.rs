@@ -1,7 +1,8 @@
 //! General contact detection through rapier2d's collision pipeline (`rapier2d-f64`, so the
 //! contact geometry is computed in f64): broad phase (BVH) and narrow phase (contact
-//! manifolds) for every shape — disks, convex polygon grains, half-planes, segments and convex
-//! polygon walls.
+//! manifolds) for disks, convex polygon grains, segments and convex polygon walls. Contacts
+//! with half-plane walls are computed here, vertex by vertex (`plane_contacts`): a half-plane
+//! is infinite and would pair with every grain in rapier's broad phase.
 //!
 //! Each grain is a collider without a rigid body (rapier integrates nothing; we move the
 //! colliders to the grains' poses each step); each wall a fixed collider. A contact manifold
@@ -221,11 +222,8 @@ impl RapierDetector {
         }
         for (w, wall) in walls.iter().enumerate() {
             let (shape, pose, kind) = match *wall {
-                Wall::Plane { point, normal } => (
-                    SharedShape::halfspace(Vector::new(normal[0], normal[1])),
-                    Pose::new(at(point), 0.0),
-                    G_STRAIGHT,
-                ),
+                // Half-planes are not given to rapier (`plane_contacts`).
+                Wall::Plane { .. } => continue,
                 Wall::Segment { a, b } => (
                     SharedShape::segment(at(a), at(b)),
                     Pose::identity(),
@@ -314,7 +312,68 @@ impl RapierDetector {
                 }
             }
         }
+        self.plane_contacts(g, walls, out);
         out.sort_unstable_by_key(|c| c.order());
+    }
+
+    /// Contacts with the half-plane walls, computed here rather than by rapier (a half-plane's
+    /// bounding box is infinite: in rapier's broad phase it pairs with every grain, which made
+    /// a detection of free-falling hexagons in a box 8 times slower). With (s, **n**) =
+    /// [`Wall::distance`] of a point (s its height above the plane, **n** towards the plane):
+    /// a disk of centre **x** has δ = R − s at **x** + (R − δ/2)**n**, key 0, as the cell
+    /// list; a polygon has one point per vertex **v**_k with s_k < prediction, δ = −s_k at the
+    /// middle of the overlap **v**_k + (s_k/2)**n**, key k. Disks only in `Coverage::All`.
+    fn plane_contacts(&self, g: &Grains, walls: &[Wall], out: &mut Vec<Contact>) {
+        for (w, wall) in walls.iter().enumerate() {
+            if !matches!(wall, Wall::Plane { .. }) {
+                continue;
+            }
+            let j = WALL_BIT | w as u32;
+            for i in 0..g.len() {
+                let c = [g.x[i], g.y[i]];
+                if g.is_disk(i) {
+                    if self.coverage == Coverage::Complement {
+                        continue;
+                    }
+                    let (s, n) = wall.distance(c);
+                    let delta = g.radius[i] - s;
+                    if delta > -self.prediction {
+                        let l = g.radius[i] - 0.5 * delta;
+                        out.push(Contact {
+                            i: i as u32,
+                            j,
+                            delta,
+                            normal: n,
+                            point: [c[0] + l * n[0], c[1] + l * n[1]],
+                            key: 0,
+                        });
+                    }
+                    continue;
+                }
+                // Whole polygon beyond reach: its bounding circle clears the plane.
+                if wall.distance(c).0 - g.radius[i] >= self.prediction {
+                    continue;
+                }
+                let (sin, cos) = g.angle[i].sin_cos();
+                for (k, v) in g.polygons.vertices(g.shape[i] as usize).iter().enumerate() {
+                    let p = [
+                        c[0] + cos * v[0] - sin * v[1],
+                        c[1] + sin * v[0] + cos * v[1],
+                    ];
+                    let (s, n) = wall.distance(p);
+                    if s < self.prediction {
+                        out.push(Contact {
+                            i: i as u32,
+                            j,
+                            delta: -s,
+                            normal: n,
+                            point: [p[0] + 0.5 * s * n[0], p[1] + 0.5 * s * n[1]],
+                            key: k as u64,
+                        });
+                    }
+                }
+            }
+        }
     }
 }
 

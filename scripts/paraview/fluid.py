@@ -11,7 +11,6 @@ are drawn over the fluid as light grey disks of their radius; a fluid run's obst
 omitted).
 """
 
-import argparse
 import os
 import sys
 
@@ -22,18 +21,10 @@ from paraview import simple as pv  # noqa: E402
 GREY = [0.75, 0.75, 0.75]
 
 
-def arguments():
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("run")
-    p.add_argument("png")
-    p.add_argument("--field", choices=["pressure", "vorticity", "speed"], default="vorticity")
-    p.add_argument("--time", type=float, default=None, help="frame time (s)")
-    p.add_argument("--size", type=int, nargs=2, default=[1600, 700], metavar=("W", "H"))
-    return p.parse_args()
-
-
 def main():
-    a = arguments()
+    a = g.render_arguments(__doc__,
+                           ("--field", dict(choices=["pressure", "vorticity", "speed"],
+                                            default="vorticity")))
     reader, kind = g.open_run(a.run)
     if kind not in ("fluid", "submerged"):
         g.fail(f"{a.run}: a {kind} run has no fluid")

@@ -9,7 +9,6 @@ frame's largest force. T is the simulated time (s) of the frame (the nearest fra
 the last frame if omitted).
 """
 
-import argparse
 import os
 import sys
 
@@ -18,17 +17,8 @@ import granflow_pv as g  # noqa: E402
 from paraview import simple as pv  # noqa: E402
 
 
-def arguments():
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("run")
-    p.add_argument("png")
-    p.add_argument("--time", type=float, default=None, help="frame time (s)")
-    p.add_argument("--size", type=int, nargs=2, default=[1600, 700], metavar=("W", "H"))
-    return p.parse_args()
-
-
 def main():
-    a = arguments()
+    a = g.render_arguments(__doc__)
     reader, kind = g.open_run(a.run)
     if kind not in ("dem", "granular", "submerged"):
         g.fail(f"{a.run}: a {kind} run has no grains (fluid.py and points.py draw the others)")

@@ -5,6 +5,7 @@ kind of a frame (docs/output.md, "The output folder of `granflow run`"). ParaVie
 turns it into a multiblock with one block per part, in part order; `part()` takes one out.
 """
 
+import argparse
 import os
 import sys
 import tomllib
@@ -39,6 +40,19 @@ def fail(message):
     """Stop the script with `message` on standard error and exit status 1."""
     print(f"error: {message}", file=sys.stderr)
     sys.exit(1)
+
+
+def render_arguments(doc, *extra):
+    """Parse a rendering script's command line: RUN PNG [--time T] [--size W H], plus the
+    options `extra` gives as (flags, keyword arguments) of `add_argument`."""
+    p = argparse.ArgumentParser(description=doc.splitlines()[0])
+    p.add_argument("run")
+    p.add_argument("png")
+    for flags, kwargs in extra:
+        p.add_argument(flags, **kwargs)
+    p.add_argument("--time", type=float, default=None, help="frame time (s)")
+    p.add_argument("--size", type=int, nargs=2, default=[1600, 700], metavar=("W", "H"))
+    return p.parse_args()
 
 
 def run_kind(run):

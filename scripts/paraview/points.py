@@ -11,7 +11,6 @@ tension positive, so negative in a resting column), `deviatoric_stress` (Pa),
 simulated time in s (nearest frame; the last if omitted).
 """
 
-import argparse
 import os
 import sys
 
@@ -20,19 +19,10 @@ import granflow_pv as g  # noqa: E402
 from paraview import simple as pv  # noqa: E402
 
 
-def arguments():
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("run")
-    p.add_argument("png")
-    p.add_argument("--field", default="mean_stress",
-                   choices=["mean_stress", "deviatoric_stress", "plastic_strain", "speed"])
-    p.add_argument("--time", type=float, default=None, help="frame time (s)")
-    p.add_argument("--size", type=int, nargs=2, default=[1600, 700], metavar=("W", "H"))
-    return p.parse_args()
-
-
 def main():
-    a = arguments()
+    a = g.render_arguments(__doc__,
+                           ("--field", dict(default="mean_stress", choices=[
+                               "mean_stress", "deviatoric_stress", "plastic_strain", "speed"])))
     reader, kind = g.open_run(a.run)
     if kind != "mpm":
         g.fail(f"{a.run}: a {kind} run has no material points")

@@ -11,6 +11,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::sync::Mutex;
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -33,8 +34,11 @@ fn paraview_found() -> bool {
 }
 
 /// `pvpython scripts/paraview/SCRIPT ARGS…`, under `xvfb-run -a` where it exists (ParaView's
-/// Debian build renders through X).
+/// Debian build renders through X). One at a time: two `xvfb-run -a` started together may pick
+/// the same display, and one of them loses its X server ("bad X server connection").
 fn pvpython(script: &str, args: &[&Path], extra: &[&str]) -> Output {
+    static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let xvfb = Command::new("xvfb-run").arg("--help").output().is_ok();
     let mut cmd = if xvfb {
         let mut c = Command::new("xvfb-run");
@@ -75,12 +79,13 @@ fn run(tmp: &Path, name: &str, scenario: &str, sets: &[&str]) -> PathBuf {
     dir
 }
 
-/// Check the run with ParaView, render it with `script`, and check the PNG.
-fn check_and_render(run: &Path, script: &str, extra: &[&str]) {
+/// Check the run with ParaView, render it with `script`, check the PNG, and return what the
+/// script printed.
+fn check_and_render(run: &Path, script: &str, extra: &[&str]) -> String {
     let text = ok("check_run.py", &pvpython("check_run.py", &[run], &[]));
     assert!(text.contains("every advertised array present"), "{text}");
     let png = run.join(format!("{}.png", script.trim_end_matches(".py")));
-    ok(script, &pvpython(script, &[run, &png], extra));
+    let printed = ok(script, &pvpython(script, &[run, &png], extra));
     let bytes = std::fs::read(&png).unwrap();
     assert!(
         bytes.starts_with(b"\x89PNG\r\n\x1a\n") && bytes.len() > 10_000,
@@ -93,6 +98,7 @@ fn check_and_render(run: &Path, script: &str, extra: &[&str]) {
         std::fs::create_dir_all(&keep).unwrap();
         std::fs::copy(&png, Path::new(&keep).join(format!("{kind}-{script}.png"))).unwrap();
     }
+    printed
 }
 
 #[test]
@@ -105,6 +111,16 @@ fn paraview_reads_and_renders_every_kind() {
 
     let dem = run(t, "dem", "tests/data/resume_dem.toml", &[]);
     check_and_render(&dem, "grains.py", &["--time", "0.15"]);
+
+    // Hexagons (68, as many as the disks): drawn as polygons from `radius` and `angle`.
+    let hexagons = run(
+        t,
+        "hexagons",
+        "tests/data/resume_dem.toml",
+        &["grains.sides=6", "time.end_tc=1"],
+    );
+    let text = check_and_render(&hexagons, "grains.py", &[]);
+    assert!(text.contains("polygons: 68 of 6 sides"), "{text}");
 
     let submerged = run(
         t,

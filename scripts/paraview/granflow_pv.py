@@ -15,7 +15,7 @@ from paraview import simple as pv
 
 # The arrays each part of a frame advertises (docs/output.md), by scenario kind:
 # (part, file prefix, "point" or "cell" data, arrays).
-GRAINS = ["radius", "velocity", "angular_velocity", "contacts", "stress", "mean_pressure"]
+GRAINS = ["radius", "velocity", "angle", "angular_velocity", "contacts", "stress", "mean_pressure"]
 CONTACTS = ["normal_force", "tangential_force", "wall"]
 ADVERTISED = {
     "fluid": [(0, "fluid", "cell", ["density", "pressure", "velocity", "vorticity", "solid"])],
@@ -55,16 +55,21 @@ def render_arguments(doc, *extra):
     return p.parse_args()
 
 
-def run_kind(run):
-    """The scenario kind of a run folder, read from its copy of the scenario."""
+def scenario(run):
+    """The run's copy of its scenario (`scenario.toml`), as a dict."""
     path = os.path.join(run, "scenario.toml")
     try:
         with open(path, "rb") as f:
-            kind = tomllib.load(f).get("kind")
+            return tomllib.load(f)
     except (OSError, tomllib.TOMLDecodeError) as e:
         fail(f"{path}: {e}")
+
+
+def run_kind(run):
+    """The scenario kind of a run folder, read from its copy of the scenario."""
+    kind = scenario(run).get("kind")
     if kind not in ADVERTISED:
-        fail(f"{path}: kind {kind!r} has no frames these scripts know")
+        fail(f"{run}/scenario.toml: kind {kind!r} has no frames these scripts know")
     return kind
 
 
@@ -162,6 +167,40 @@ def disks(grains, z=0.0):
     glyph.GlyphMode = "All Points"
     glyph.GlyphTransform.Translate = [0.0, 0.0, z]
     return glyph
+
+
+def polygons(grains, sides, z=0.0):
+    """Polygon grains (a collapse with `grains.sides` = n) as filled regular n-gons at height
+    `z`: vertex k of grain i at x_i + R_i (cos(θ_i + 2πk/n), sin(θ_i + 2πk/n)), R_i its `radius`
+    (the circumradius) and θ_i its `angle`; each polygon carries its grain's `velocity` as cell
+    data."""
+    f = pv.ProgrammableFilter(Input=grains)
+    f.OutputDataSetType = "vtkPolyData"
+    f.Script = f"""
+import math
+import vtk
+n, z = {int(sides)}, {float(z)}
+inp = self.GetInput()
+out = self.GetOutput()
+data = inp.GetPointData()
+radius, angle, velocity = (data.GetArray(a) for a in ("radius", "angle", "velocity"))
+points, cells = vtk.vtkPoints(), vtk.vtkCellArray()
+vel = vtk.vtkDoubleArray()
+vel.SetName("velocity")
+vel.SetNumberOfComponents(3)
+for i in range(inp.GetNumberOfPoints()):
+    x, y, _ = inp.GetPoint(i)
+    r, t = radius.GetValue(i), angle.GetValue(i)
+    cells.InsertNextCell(n)
+    for k in range(n):
+        a = t + 2.0 * math.pi * k / n
+        cells.InsertCellPoint(points.InsertNextPoint(x + r * math.cos(a), y + r * math.sin(a), z))
+    vel.InsertNextTuple(velocity.GetTuple(i))
+out.SetPoints(points)
+out.SetPolys(cells)
+out.GetCellData().AddArray(vel)
+"""
+    return f
 
 
 def flat(display):

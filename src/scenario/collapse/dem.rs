@@ -197,6 +197,7 @@ pub fn write_frame(
         &[
             Field::scalar("radius", &g.radius),
             Field::vector("velocity", &vel),
+            Field::scalar("angle", &g.angle),
             Field::scalar("angular_velocity", &g.omega),
             Field::scalar("contacts", contacts),
             Field::tensor("stress", &stress),

@@ -316,7 +316,7 @@ fn hexagon_column_deposits() {
     let c = equal_area_circumradius(6, 1.0);
     for i in 0..g.len() {
         assert!(!g.is_disk(i));
-        assert_eq!(g.world_vertices(i).len(), 6);
+        assert_eq!(g.world_vertices(i).count(), 6);
         let area = std::f64::consts::PI * (g.radius[i] / c).powi(2);
         assert!((g.mass[i] / area - 1.0).abs() < 1e-12, "grain {i}");
     }

@@ -354,12 +354,7 @@ impl RapierDetector {
                 if wall.distance(c).0 - g.radius[i] >= self.prediction {
                     continue;
                 }
-                let (sin, cos) = g.angle[i].sin_cos();
-                for (k, v) in g.polygons.vertices(g.shape[i] as usize).iter().enumerate() {
-                    let p = [
-                        c[0] + cos * v[0] - sin * v[1],
-                        c[1] + sin * v[0] + cos * v[1],
-                    ];
+                for (k, p) in g.world_vertices(i).enumerate() {
                     let (s, n) = wall.distance(p);
                     if s < self.prediction {
                         out.push(Contact {

@@ -119,22 +119,17 @@ impl Grains {
     }
 
     /// Vertices of polygon grain `i` in the world frame, **x**_i + R(θ_i) **v**_k (body-frame
-    /// vertices **v**_k of its shape); empty for a disk.
-    pub fn world_vertices(&self, i: usize) -> Vec<[f64; 2]> {
-        if self.is_disk(i) {
-            return Vec::new();
-        }
+    /// vertices **v**_k of its shape, in order); none for a disk.
+    pub fn world_vertices(&self, i: usize) -> impl Iterator<Item = [f64; 2]> + '_ {
+        let body: &[[f64; 2]] = if self.is_disk(i) {
+            &[]
+        } else {
+            self.polygons.vertices(self.shape[i] as usize)
+        };
         let (sin, cos) = self.angle[i].sin_cos();
-        self.polygons
-            .vertices(self.shape[i] as usize)
-            .iter()
-            .map(|v| {
-                [
-                    self.x[i] + cos * v[0] - sin * v[1],
-                    self.y[i] + sin * v[0] + cos * v[1],
-                ]
-            })
-            .collect()
+        let (x, y) = (self.x[i], self.y[i]);
+        body.iter()
+            .map(move |v| [x + cos * v[0] - sin * v[1], y + sin * v[0] + cos * v[1]])
     }
 
     /// Area of grain `i` (m², or m² per unit depth): πR² for a disk, its shape's area for a
@@ -153,11 +148,9 @@ impl Grains {
         if self.is_disk(i) {
             return [self.x[i] + self.radius[i], self.y[i] + self.radius[i]];
         }
-        self.world_vertices(i)
-            .iter()
-            .fold([f64::NEG_INFINITY; 2], |m, v| {
-                [m[0].max(v[0]), m[1].max(v[1])]
-            })
+        self.world_vertices(i).fold([f64::NEG_INFINITY; 2], |m, v| {
+            [m[0].max(v[0]), m[1].max(v[1])]
+        })
     }
 
     /// Whether some grain is a polygon.

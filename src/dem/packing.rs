@@ -77,7 +77,7 @@ pub fn strip_fraction(g: &Grains, x0: f64, x1: f64, y_a: f64, y_b: f64) -> f64 {
                 disk_area_below(g.radius[i], y_b - g.y[i])
                     - disk_area_below(g.radius[i], y_a - g.y[i])
             } else {
-                let v = g.world_vertices(i);
+                let v: Vec<[f64; 2]> = g.world_vertices(i).collect();
                 polygon_area_below(&v, y_b) - polygon_area_below(&v, y_a)
             }
         })

@@ -1,5 +1,5 @@
 //! DEM validation cases, each returning one [`Check`] per measured quantity, for
-//! `granflow validate` and the tests in `tests/dem.rs`.
+//! `granflow validate` and the tests in `tests/suite/dem.rs`.
 //!
 //! | case | claim | reference |
 //! |---|---|---|

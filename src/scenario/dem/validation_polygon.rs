@@ -1,5 +1,5 @@
 //! Validation of the rapier2d-backed detection and of polygon grains (`granflow validate
-//! dem-polygon`), one [`Check`] per measured quantity; `tests/dem_rapier.rs` runs the same
+//! dem-polygon`), one [`Check`] per measured quantity; `tests/suite/dem_rapier.rs` runs the same
 //! measurements.
 //!
 //! | quantity | claim | reference |

@@ -543,7 +543,7 @@ pub fn document(schemas: &[Value]) -> String {
         "# Scenario keys\n\n\
          <!-- Generated from the scenario types: do not edit. Regenerate with\n     \
          cargo run --release -- schema all --markdown > docs/scenario-keys.md\n     \
-         (tests/schema.rs fails while this file differs from what the binary prints). -->\n\n\
+         (tests/suite/schema.rs fails while this file differs from what the binary prints). -->\n\n\
          Every key of every kind of scenario file, made from the JSON Schema that \
          `granflow schema KIND` prints, itself generated from the types the parser reads, \
          so this page and the parser cannot disagree. How the files are written, and why, \

@@ -44,6 +44,7 @@ fn run_case(name: &str) {
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 40 s on 2 cores): cargo test -- --ignored"]
 fn poiseuille() {
     run_case("poiseuille");
 }
@@ -54,11 +55,13 @@ fn taylor_green() {
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 20 s on 2 cores): cargo test -- --ignored"]
 fn conservation() {
     run_case("conservation");
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 15 s on 2 cores): cargo test -- --ignored"]
 fn les_channel() {
     run_case("les-channel");
 }
@@ -69,21 +72,25 @@ fn cavity_re100() {
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 20 s on 2 cores): cargo test -- --ignored"]
 fn cavity_re1000() {
     run_case("cavity-re1000");
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 40 s on 2 cores): cargo test -- --ignored"]
 fn cylinder_2d1() {
     run_case("cylinder-2d1");
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 40 s on 2 cores): cargo test -- --ignored"]
 fn cylinder_array() {
     run_case("cylinder-array");
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 30 s on 2 cores): cargo test -- --ignored"]
 fn shedding() {
     run_case("shedding");
 }

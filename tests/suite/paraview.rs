@@ -4,14 +4,14 @@
 //! `grains.py`, `fluid.py` and `points.py`.
 //!
 //! Needs `pvpython` (Debian's `python3-paraview`) and, for rendering without a display,
-//! `xvfb-run` (Debian's `xvfb`). Without them the tests say so and pass; CI installs both and
+//! `Xvfb` (Debian's `xvfb`). Without them the tests say so and pass; CI installs both and
 //! sets `GRANFLOW_REQUIRE_PARAVIEW=1`, which turns a missing ParaView into a failure.
 //!
 //! Set `GRANFLOW_KEEP_PARAVIEW=<dir>` to keep the rendered PNGs.
 
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::sync::Mutex;
+use std::process::{Child, Command, Output, Stdio};
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -33,20 +33,58 @@ fn paraview_found() -> bool {
     found
 }
 
-/// `pvpython scripts/paraview/SCRIPT ARGS…`, under `xvfb-run -a` where it exists (ParaView's
-/// Debian build renders through X). One at a time: two `xvfb-run -a` started together may pick
-/// the same display, and one of them loses its X server ("bad X server connection").
+/// A private X server for one ParaView call (Debian's ParaView renders through X):
+/// `Xvfb -displayfd 1` picks a free display itself and prints its number once it accepts
+/// connections, so calls never share or race for a display (`xvfb-run -a` could hand a call a
+/// display whose server was still going away: "bad X server connection"). Killed on drop.
+struct Xvfb {
+    server: Child,
+    display: String,
+}
+
+impl Xvfb {
+    /// `None` where there is no `Xvfb` (a desktop with its own display).
+    fn start() -> Option<Xvfb> {
+        let mut server = Command::new("Xvfb")
+            .args([
+                "-displayfd",
+                "1",
+                "-screen",
+                "0",
+                "1280x1024x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .ok()?;
+        let mut number = String::new();
+        BufReader::new(server.stdout.take().unwrap())
+            .read_line(&mut number)
+            .unwrap();
+        assert!(!number.trim().is_empty(), "Xvfb did not start");
+        Some(Xvfb {
+            server,
+            display: format!(":{}", number.trim()),
+        })
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.server.kill();
+        let _ = self.server.wait();
+    }
+}
+
+/// `pvpython scripts/paraview/SCRIPT ARGS…`, on its own [`Xvfb`] where there is one.
 fn pvpython(script: &str, args: &[&Path], extra: &[&str]) -> Output {
-    static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
-    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let xvfb = Command::new("xvfb-run").arg("--help").output().is_ok();
-    let mut cmd = if xvfb {
-        let mut c = Command::new("xvfb-run");
-        c.args(["-a", "pvpython"]);
-        c
-    } else {
-        Command::new("pvpython")
-    };
+    let xvfb = Xvfb::start();
+    let mut cmd = Command::new("pvpython");
+    if let Some(x) = &xvfb {
+        cmd.env("DISPLAY", &x.display);
+    }
     cmd.arg(root().join("scripts/paraview").join(script))
         .args(args)
         .args(extra)
@@ -102,6 +140,7 @@ fn check_and_render(run: &Path, script: &str, extra: &[&str]) -> String {
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 40 s on 2 cores): cargo test -- --ignored"]
 fn paraview_reads_and_renders_every_kind() {
     if !paraview_found() {
         return;
@@ -155,6 +194,7 @@ fn paraview_reads_and_renders_every_kind() {
 
 /// The check can fail: a fluid run's frames, labelled as a DEM run, lack the grains' arrays.
 #[test]
+#[ignore = "heavy tier (≈ 14 s on 2 cores): cargo test -- --ignored"]
 fn a_run_without_the_advertised_arrays_is_refused() {
     if !paraview_found() {
         return;

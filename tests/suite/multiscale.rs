@@ -2,7 +2,7 @@
 //! runs through the collapse runner and writes the volumes' state with the points. The
 //! physics of the volume (objectivity, MPM consistency, energy, preparation) is tested beside
 //! its code in `granflow::dem::periodic_cell` and `granflow::coupling::rve`, and against the
-//! wall-bounded biaxial test in `tests/dem_biaxial.rs`.
+//! wall-bounded biaxial test in `tests/suite/dem_biaxial.rs`.
 
 use granflow::scenario::checkpointing::Control;
 use granflow::scenario::collapse::mpm::run_column_collapse_with;

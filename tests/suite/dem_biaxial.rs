@@ -27,6 +27,7 @@ fn sample(prep_friction: f64) -> BiaxialResult {
 /// * loose and dense reach the same critical sin φ within 0.06 (each is a mean over ≈ 60
 ///   records whose standard deviation is ≈ 0.04–0.05) and the same solid fraction within 0.01.
 #[test]
+#[ignore = "heavy tier (≈ 30 s on 2 cores): cargo test -- --ignored"]
 fn loose_and_dense_samples_reach_one_critical_state() {
     let (loose, dense) = std::thread::scope(|s| {
         let l = s.spawn(|| sample(0.53));
@@ -52,6 +53,7 @@ fn loose_and_dense_samples_reach_one_critical_state() {
 /// deposit of `sample(0.53)` consolidated the same way (0.778, docs/dev/dem-status.md; measured
 /// 0.764).
 #[test]
+#[ignore = "heavy tier (≈ 30 s on 2 cores): cargo test -- --ignored"]
 fn a_sedimented_sample_consolidates_and_shears() {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/column_collapse/dem_a2.toml");
@@ -74,6 +76,7 @@ fn a_sedimented_sample_consolidates_and_shears() {
 /// validation case at test size (its gates and their sources are in
 /// `granflow::scenario::dem::rve_biaxial::validation`).
 #[test]
+#[ignore = "heavy tier (≈ 40 s on 2 cores): cargo test -- --ignored"]
 fn the_periodic_volume_and_the_walls_agree_on_the_critical_state() {
     let checks =
         granflow::scenario::dem::rve_biaxial::validation(granflow::report::Fidelity::Test).unwrap();

@@ -1,7 +1,7 @@
 //! Conservation on random small set-ups of each solver (property tests, issue 24): what the
 //! equations conserve, the solvers keep to round-off, whatever the size, parameters and
 //! initial state. The fixed cases of `granflow validate` check the same laws on one set-up each;
-//! these draw `PROPTEST_CASES` set-ups (16 by default here; see tests/fuzz_scenarios.rs for a
+//! these draw `PROPTEST_CASES` set-ups (16 by default here; see tests/suite/fuzz_scenarios.rs for a
 //! long campaign).
 
 use proptest::prelude::*;

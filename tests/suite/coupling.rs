@@ -26,6 +26,7 @@ fn assert_passes(case: &str) {
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 40 s on 2 cores): cargo test -- --ignored"]
 fn psm_cylinder_array() {
     assert_passes("psm-cylinder-array");
 }
@@ -105,6 +106,7 @@ fn zero_weight_is_the_plain_step() {
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 10 s on 2 cores): cargo test -- --ignored"]
 fn drafting_kissing_tumbling() {
     assert_passes("dkt");
 }

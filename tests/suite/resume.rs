@@ -184,6 +184,7 @@ fn reference() -> &'static Path {
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 20 s on 2 cores): cargo test -- --ignored"]
 fn a_run_killed_part_way_resumes_to_the_uninterrupted_result() {
     let dir = tempfile::tempdir().unwrap();
     let mut child = spawn(&["--checkpoint-every", "2.0"], dir.path());
@@ -205,6 +206,7 @@ fn a_run_killed_part_way_resumes_to_the_uninterrupted_result() {
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 10 s on 2 cores): cargo test -- --ignored"]
 fn sigterm_saves_a_checkpoint_exits_143_and_resumes_to_the_uninterrupted_result() {
     let dir = tempfile::tempdir().unwrap();
     // No --checkpoint-every: the signal alone writes the checkpoint.
@@ -353,6 +355,7 @@ fn an_mpm_collapse_stopped_or_killed_part_way_resumes_to_the_uninterrupted_resul
 
 /// The points' representative volumes (grains, contacts, springs) are part of the checkpoint.
 #[test]
+#[ignore = "heavy tier (≈ 30 s on 2 cores): cargo test -- --ignored"]
 fn an_mpm_dem_collapse_stopped_or_killed_part_way_resumes_to_the_uninterrupted_result() {
     let (text, mut s) = small_mpm("rve_a1.toml", 4.0, 0.3);
     let MaterialSpec::Rve { grains, .. } = &mut s.material else {
@@ -370,6 +373,7 @@ fn an_mpm_dem_collapse_stopped_or_killed_part_way_resumes_to_the_uninterrupted_r
 /// the run stops naming the last complete frame and checkpoint, leaves no partial file, and
 /// resumes to the uninterrupted result once the output can be written again.
 #[test]
+#[ignore = "heavy tier (≈ 20 s on 2 cores): cargo test -- --ignored"]
 fn a_full_disk_stops_the_run_naming_its_last_frame_and_checkpoint_and_it_resumes() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
@@ -468,7 +472,7 @@ fn small_submerged(ladd: bool) -> (String, SubmergedScenario) {
     s.time.frame_interval_tc = 0.25;
     s.time.series_interval_tc = 0.05;
     if ladd {
-        // At the file's τ = 0.53 Ladd's bounce-back goes unstable (tests/submerged.rs).
+        // At the file's τ = 0.53 Ladd's bounce-back goes unstable (tests/suite/submerged.rs).
         s.coupling.method = granflow::scenario::submerged::CouplingMethod::Ladd;
         s.coupling.tau = Some(0.6);
     }

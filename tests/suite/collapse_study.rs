@@ -38,6 +38,7 @@ fn reduced_sweep(keep: &[f64]) -> String {
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 90 s on 2 cores): cargo test -- --ignored"]
 fn quick_sweep_reduced_shows_the_ordering_and_bands() {
     let dir = tempfile::tempdir().unwrap();
     let sweep = dir.path().join("sweep.toml");

@@ -1,12 +1,12 @@
 //! Round trips of the VTK writers, in every format (`[vtk]`: no compression, zlib, LZ4; f64
-//! or f32), through a reader that follows VTK's file format (`tests/common/vtk.rs`) and, when
+//! or f32), through a reader that follows VTK's file format (`tests/suite/common/vtk.rs`) and, when
 //! the `vtk` Python package is installed, through VTK's own XML readers
 //! (`scripts/check_vtk.py`). CI installs it and sets `GRANFLOW_REQUIRE_VTK=1`, which turns a
 //! missing `vtk` into a failure instead of a skip.
 //!
 //! Set `GRANFLOW_KEEP_IO_FILES=<dir>` to keep copies of the written files.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

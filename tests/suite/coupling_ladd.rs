@@ -27,6 +27,7 @@ fn assert_passes(case: &str) {
 }
 
 #[test]
+#[ignore = "heavy tier (≈ 20 s on 2 cores): cargo test -- --ignored"]
 fn ladd_cylinder_array() {
     assert_passes("ladd-cylinder-array");
 }

@@ -1,7 +1,7 @@
 //! A reader of the VTK XML files granflow writes (appended raw data, UInt64 headers, no
 //! compression, zlib or LZ4), for the tests: the XML text and every `DataArray` decoded to
 //! `f64`. It follows VTK's file format description, not granflow's writer, so a round trip
-//! through it checks the bytes the writer lays out. (`tests/io_vtk.rs` also has VTK itself
+//! through it checks the bytes the writer lays out. (`tests/suite/io_vtk.rs` also has VTK itself
 //! read the files when the `vtk` Python package is there.)
 
 use std::io::Read;

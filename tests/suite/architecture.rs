@@ -897,7 +897,7 @@ fn every_module_and_reference_is_in_a_known_room() {
         let room = t.room(k);
         if !room.is_empty() && !LIBRARY.contains(&room) {
             bad.push(format!(
-                "{}: room `{room}` is not in the list of rooms of tests/architecture.rs \
+                "{}: room `{room}` is not in the list of rooms of tests/suite/architecture.rs \
                  (add it to BASE, SOLVERS or LIBRARY, and to docs/architecture.md)",
                 f.rel
             ));

@@ -27,6 +27,7 @@
 pub mod checkpointing;
 pub mod collapse;
 pub mod dem;
+pub mod field;
 pub mod fluid;
 pub mod granular;
 pub mod mpm;

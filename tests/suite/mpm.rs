@@ -361,3 +361,128 @@ fn musl_remap_keeps_the_floor_contact_of_the_update() {
     // (what the update's contact overrides).
     assert!(held > 0 && lifting > 0, "held {held}, lifting {lifting}");
 }
+
+/// The a = 0.5 column of `mpm_a0.5.toml` as a linear elastic body (the file's density,
+/// E = 1.98 MPa and ν = 0.23) on frictionless walls, with `initial` as its `[initial]` table.
+fn elastic_column(initial: &str) -> granflow::mpm::Mpm {
+    let text = std::fs::read_to_string(model("0.5")).unwrap();
+    let mut table: toml::Table = text.parse().unwrap();
+    table["material"] = toml::Value::Table(
+        "model = \"linear_elastic\"\ndensity = 1925.0\nyoungs_modulus = 1.98e6\npoisson_ratio = 0.23"
+            .parse()
+            .unwrap(),
+    );
+    for wall in ["base", "back", "end"] {
+        table["walls"][wall]["mu"] = toml::Value::Float(0.0);
+    }
+    let text = format!(
+        "{}\n[initial]\n{initial}\n",
+        toml::to_string(&table).unwrap()
+    );
+    MpmScenario::from_toml(&text).unwrap().build().unwrap().0
+}
+
+/// Largest point speed over `steps` steps.
+fn peak_speed(mpm: &mut granflow::mpm::Mpm, steps: usize) -> f64 {
+    let mut peak: f64 = 0.0;
+    for _ in 0..steps {
+        mpm.step().unwrap();
+        let v = mpm.points.vel.iter().map(|v| v[0].hypot(v[1]));
+        peak = peak.max(v.fold(0.0, f64::max));
+    }
+    peak
+}
+
+/// Geostatic stress as data: the column of height H = 27.5 mm started at σ_yy = −ρ g (H − y),
+/// σ_xx = σ_xy = 0 (equilibrium with its weight and its free sides) stays at rest, while started
+/// at zero stress it falls onto its base and rings. The zero-stress start's peak speed is the
+/// free fall of the top until the compression wave from the base reaches it, g H / c =
+/// 7.8 mm/s with c = √(M/ρ) = 34.5 m/s (M the plane-strain P-wave modulus; a 1-D estimate, so
+/// within 25 %; measured 8.6 mm/s). The geostatic start's peak over the same 300 steps
+/// (≈ 2.5 wave transits) must be below 1e-6 of it: GIMP's internal forces balance this linear
+/// stress field and the weight to round-off (measured 9e-18 m/s).
+#[test]
+fn a_column_started_at_its_geostatic_stress_stays_at_rest() {
+    let rest = "stress = [0.0, \"-1925*9.81*(0.0275 - y)\", 0.0, \"-0.23*1925*9.81*(0.0275 - y)\"]";
+    let mut geostatic = elastic_column(rest);
+    let mut unstressed = elastic_column("velocity = [0.0, 0.0]");
+    let (a, b) = (
+        peak_speed(&mut geostatic, 300),
+        peak_speed(&mut unstressed, 300),
+    );
+    println!(
+        "peak speed: geostatic {a:.3e} m/s, zero stress {b:.3e} m/s, ratio {:.3}",
+        a / b
+    );
+    assert!(
+        (b / (9.81 * 0.0275 / 34.5) - 1.0).abs() < 0.25,
+        "zero-stress start: {b} m/s"
+    );
+    assert!(a < 1e-6 * b, "geostatic {a} m/s against {b} m/s");
+}
+
+/// A velocity field as data: the column started at u = 0.05 m/s along x (and at its geostatic
+/// stress), on frictionless walls and with gravity along −y, keeps its x momentum M u to
+/// round-off (1e-12 relative), and its centre of mass moves at u (to 1e-9 m over 200 steps).
+#[test]
+fn an_initial_velocity_moves_the_column_with_its_momentum() {
+    let mut mpm = elastic_column(
+        "velocity = [0.05, 0.0]\n\
+         stress = [0.0, \"-1925*9.81*(0.0275 - y)\", 0.0, \"-0.23*1925*9.81*(0.0275 - y)\"]",
+    );
+    let p = &mpm.points;
+    let mass: f64 = p.mass.iter().sum();
+    let centre = |p: &granflow::mpm::points::Points<_>| {
+        p.mass
+            .iter()
+            .zip(&p.pos)
+            .map(|(m, x)| m * x[0])
+            .sum::<f64>()
+            / mass
+    };
+    let x0 = centre(p);
+    mpm.steps(200).unwrap();
+    let p = &mpm.points;
+    let momentum: f64 = p.mass.iter().zip(&p.vel).map(|(m, v)| m * v[0]).sum();
+    assert!((momentum / (mass * 0.05) - 1.0).abs() < 1e-12, "{momentum}");
+    let moved = centre(p) - x0;
+    assert!(
+        (moved - 0.05 * mpm.time()).abs() < 1e-9,
+        "{moved} m in {} s",
+        mpm.time()
+    );
+}
+
+/// `[initial]` expressions are checked like the fluid's: a bad one is refused naming its key,
+/// and a stress is refused with the `rve` model.
+#[test]
+fn bad_initial_fields_are_refused_naming_the_key() {
+    let text = std::fs::read_to_string(model("0.5")).unwrap();
+    let with = |initial: &str| {
+        MpmScenario::from_toml(&format!("{text}\n[initial]\n{initial}\n"))
+            .and_then(|s| s.build())
+            .err()
+            .unwrap()
+            .to_string()
+    };
+    let e = with("velocity = [\"sin(z)\", 0.0]");
+    assert!(
+        e.contains("initial.velocity[0]") && e.contains("`z`"),
+        "{e}"
+    );
+    let e = with("stress = [0.0, \"ln(y - 1)\", 0.0, 0.0]");
+    assert!(
+        e.contains("initial.stress[1]") && e.contains("not finite"),
+        "{e}"
+    );
+    let rve = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/column_collapse/rve_a1.toml");
+    let rve = std::fs::read_to_string(rve).unwrap();
+    let e = MpmScenario::from_toml(&format!(
+        "{rve}\n[initial]\nstress = [0.0, 0.0, 0.0, 0.0]\n"
+    ))
+    .and_then(|s| s.derive().map(|_| ()))
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(e.contains("initial.stress") && e.contains("rve"), "{e}");
+}

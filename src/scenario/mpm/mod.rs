@@ -10,6 +10,7 @@
 
 pub mod bench;
 pub mod bench_rve;
+pub mod initial;
 pub mod spec;
 pub mod validation;
 

@@ -27,6 +27,7 @@ use crate::mpm::points::Points;
 use crate::mpm::shape::ShapeKind;
 use crate::mpm::solver::{Mpm, MpmParams, Scheme, Transfer};
 use crate::scenario::dem::spec::{ContactSpec, GrainsSpec};
+use crate::scenario::mpm::initial::MpmInitialSpec;
 use crate::scenario::{non_negative, positive, Kind, ScenarioFile};
 use crate::{Error, Result};
 
@@ -50,6 +51,10 @@ pub struct MpmScenario {
     pub mpm: MpmSpec,
     /// Wall conditions.
     pub walls: WallsSpec,
+    /// The points' initial velocity and stress (`[initial]`, optional: at rest; zero stress
+    /// with a closed-form law, geostatic with `rve`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial: Option<MpmInitialSpec>,
     /// Time step, outputs, stop.
     pub time: MpmTimeSpec,
     /// How VTK frames are written (`[vtk]`, optional: zlib-compressed, f64, if absent).
@@ -517,6 +522,14 @@ impl MpmScenario {
     pub fn derive(&self) -> Result<DerivedMpm> {
         positive("gravity", self.gravity)?;
         let material = self.material.build()?;
+        if let Some(initial) = &self.initial {
+            if initial.compile()?.has_stress() && matches!(material, Law::Volume(_)) {
+                return Err(Error::config(
+                    "initial.stress",
+                    "the rve model's points start at the geostatic stress of material.k0",
+                ));
+            }
+        }
         let c = &self.column;
         positive("column.width", c.width)?;
         positive("column.aspect_ratio", c.aspect_ratio)?;
@@ -650,8 +663,9 @@ impl MpmScenario {
     }
 
     /// Build the solver at t = 0 with `material`, every point starting from
-    /// [`crate::mpm::Material::initial_state`] at the stress `initial` gives at its position
-    /// (the closed-form laws start from zero stress).
+    /// [`crate::mpm::Material::initial_state`] at the stress `[initial]` gives at its position,
+    /// or else the stress `initial` gives (zero for the closed-form laws), and at the velocity
+    /// `[initial]` gives (else at rest).
     pub fn build_with<M: crate::mpm::Material>(
         &self,
         material: M,
@@ -698,7 +712,19 @@ impl MpmScenario {
         };
         let mut mpm = Mpm::new(grid, pts, material, params)?;
         mpm.set_transfer(self.mpm.transfer)?;
-        mpm.set_stress(initial)?;
+        let given = self.initial.as_ref().map(|i| i.compile()).transpose()?;
+        let Some(given) = given else {
+            mpm.set_stress(initial)?;
+            return Ok(mpm);
+        };
+        given.check(&mpm.points.pos)?;
+        mpm.set_stress(|x| given.stress(x).unwrap_or_else(|| initial(x)))?;
+        let p = &mut mpm.points;
+        for (v, &x) in p.vel.iter_mut().zip(&p.pos) {
+            if let Some(u) = given.velocity(x) {
+                *v = u;
+            }
+        }
         Ok(mpm)
     }
 }

@@ -47,7 +47,7 @@ fn detect() -> Level {
 /// Evaluates an expression in a copy of the code compiled for this CPU's [`Level`] (checked
 /// at each use: one predictable branch, so use it per chunk of work, not per element).
 ///
-/// ```ignore
+/// ```text
 /// crate::exec::simd::dispatch!(kernel::<T>(a, b))
 /// ```
 ///
@@ -96,7 +96,7 @@ pub(crate) fn at_level<R>(f: impl FnOnce() -> R) -> R {
 /// Defines a function whose body is compiled for every [`Level`] and run at this CPU's
 /// ([`dispatch!`]).
 ///
-/// ```ignore
+/// ```text
 /// multiversion! {
 ///     /// Doc comment.
 ///     pub(super) fn kernel(a: &mut [f64], b: &[f64]) -> f64 { … }

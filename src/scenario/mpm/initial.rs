@@ -47,25 +47,28 @@ impl MpmInitialSpec {
     /// Compile the expressions; one that does not parse or uses a variable other than x and y
     /// is refused naming its key.
     pub fn compile(&self) -> Result<MpmInitial> {
-        let velocity = match &self.velocity {
-            Some(v) => Some([
-                Scalar::new(VELOCITY_KEYS[0], &v[0])?,
-                Scalar::new(VELOCITY_KEYS[1], &v[1])?,
-            ]),
-            None => None,
-        };
-        let stress = match &self.stress {
-            Some(s) => {
-                let mut parts = Vec::with_capacity(4);
-                for (key, v) in STRESS_KEYS.iter().zip(s) {
-                    parts.push(Scalar::new(key, v)?);
-                }
-                parts.try_into().ok()
-            }
-            None => None,
-        };
-        Ok(MpmInitial { velocity, stress })
+        Ok(MpmInitial {
+            velocity: compile(&VELOCITY_KEYS, self.velocity.as_ref())?,
+            stress: compile(&STRESS_KEYS, self.stress.as_ref())?,
+        })
     }
+}
+
+/// The components of one field, each read from its key.
+fn compile<const N: usize>(
+    keys: &[&'static str; N],
+    values: Option<&[FieldValue; N]>,
+) -> Result<Option<[Scalar; N]>> {
+    let Some(values) = values else {
+        return Ok(None);
+    };
+    let parts: Vec<Scalar> = keys
+        .iter()
+        .zip(values)
+        .map(|(key, v)| Scalar::new(key, v))
+        .collect::<Result<_>>()?;
+    // N keys zipped with N values: the length is N.
+    Ok(parts.try_into().ok())
 }
 
 /// `parts` at `x` (NaN where an expression cannot be evaluated).
@@ -94,11 +97,6 @@ impl MpmInitial {
             }
         }
         Ok(())
-    }
-
-    /// Whether a stress is given.
-    pub fn has_stress(&self) -> bool {
-        self.stress.is_some()
     }
 
     /// The stress (xx, yy, xy, zz) at `x`, if given.

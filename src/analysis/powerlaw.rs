@@ -39,7 +39,7 @@ impl PowerLaw {
 
 /// Least squares y ≈ X β (columns of X given): β, its covariance s²(XᵀX)⁻¹ (`None` without
 /// degrees of freedom) and the residual sum of squares.
-fn least_squares(columns: &[Vec<f64>], y: &[f64]) -> (Vec<f64>, Option<Mat<f64>>, f64) {
+pub(crate) fn least_squares(columns: &[Vec<f64>], y: &[f64]) -> (Vec<f64>, Option<Mat<f64>>, f64) {
     let (n, p) = (y.len(), columns.len());
     let x = Mat::from_fn(n, p, |i, j| columns[j][i]);
     let rhs = Mat::from_fn(n, 1, |i, _| y[i]);

@@ -229,6 +229,11 @@ impl RapierDetector {
                     Pose::identity(),
                     G_STRAIGHT,
                 ),
+                Wall::Disk { centre, radius } => (
+                    SharedShape::ball(u * radius),
+                    Pose::new(at(centre), 0.0),
+                    G_STRAIGHT,
+                ),
                 Wall::Polygon { vertices, n } => (
                     SharedShape::convex_polyline(
                         vertices[..n as usize].iter().map(|&v| at(v)).collect(),
@@ -396,7 +401,7 @@ fn rapier_unit(g: &Grains) -> f64 {
 pub fn cell_list_contacts(g: &Grains, walls: &[Wall], skin: f64, gap: f64) -> Vec<Contact> {
     let mut det = Detector::new(skin);
     let (mut pl, mut wl) = (PairList::default(), WallList::default());
-    det.build(g, walls, &mut pl, &mut wl);
+    det.build(g, walls, None, &mut pl, &mut wl);
     let mut out = Vec::new();
     for p in 0..pl.i.len() {
         let (i, j) = (pl.i[p] as usize, pl.j[p] as usize);

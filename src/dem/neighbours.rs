@@ -6,7 +6,10 @@
 //! the two sorted lists — no hashing, no per-pair heap object.
 //!
 //! Cells are squares of side h ≥ 2R_max + skin laid over the bounding box of the grains, so the
-//! 3 × 3 cells around a grain hold every partner. Grains are binned by a counting sort; the
+//! 3 × 3 cells around a grain hold every partner. In a domain periodic in x over [x0, x1) the
+//! columns of cells tile the period exactly (width L/⌊L/h⌋ ≥ h, at least 3 columns), the
+//! neighbour columns wrap around, and separations are minimal images; the caller wraps the
+//! positions into the period before a build. Grains are binned by a counting sort; the
 //! pair search runs in parallel over fixed chunks of grains, each chunk writing to its own
 //! reused buffer, which are concatenated in order (the list is identical for any thread
 //! count).
@@ -15,6 +18,7 @@ use rayon::prelude::*;
 
 use super::contact::ContactState;
 use super::grains::Grains;
+use super::params::min_image;
 use super::walls::Wall;
 
 /// Grains per parallel chunk of the pair search.
@@ -104,18 +108,26 @@ impl Detector {
         (&self.x_ref, &self.y_ref, 0.25 * self.skin * self.skin)
     }
 
-    /// Rebuild both lists from the current positions, carrying history over.
-    pub fn build(&mut self, g: &Grains, walls: &[Wall], pairs: &mut PairList, wl: &mut WallList) {
+    /// Rebuild both lists from the current positions, carrying history over; `periodic_x`
+    /// as in [`super::DemParams::periodic_x`] (positions already wrapped into it).
+    pub fn build(
+        &mut self,
+        g: &Grains,
+        walls: &[Wall],
+        periodic_x: Option<[f64; 2]>,
+        pairs: &mut PairList,
+        wl: &mut WallList,
+    ) {
         self.builds += 1;
         self.x_ref.clear();
         self.x_ref.extend_from_slice(&g.x);
         self.y_ref.clear();
         self.y_ref.extend_from_slice(&g.y);
-        self.build_pairs(g, pairs);
+        self.build_pairs(g, periodic_x, pairs);
         self.build_walls(g, walls, wl);
     }
 
-    fn build_pairs(&mut self, g: &Grains, pl: &mut PairList) {
+    fn build_pairs(&mut self, g: &Grains, periodic_x: Option<[f64; 2]>, pl: &mut PairList) {
         let n = g.len();
         let skin = self.skin;
         // Bounding box; grains with non-finite positions are left out of the search.
@@ -146,13 +158,21 @@ impl Detector {
             }
             h *= 1.5;
         }
+        // Periodic columns: ⌊L/h⌋ of them, each L/⌊L/h⌋ ≥ h wide (`Dem::new` checks L ≥ 3h).
+        let (mut hx, period) = (h, periodic_x.map(|[a, b]| b - a));
+        if let Some([a, b]) = periodic_x {
+            ncx = (((b - a) / h) as usize).max(3);
+            hx = (b - a) / ncx as f64;
+            x0 = a;
+        }
+        let wrap = period.is_some();
         let ncell = ncx * ncy;
         self.cell_of.clear();
         self.cell_start.clear();
         self.cell_start.resize(ncell + 1, 0);
         for k in 0..n {
             let c = if g.x[k].is_finite() && g.y[k].is_finite() {
-                let cx = (((g.x[k] - x0) / h) as usize).min(ncx - 1);
+                let cx = (((g.x[k] - x0) / hx) as usize).min(ncx - 1);
                 let cy = (((g.y[k] - y0) / h) as usize).min(ncy - 1);
                 (cy * ncx + cx) as u32
             } else {
@@ -195,15 +215,23 @@ impl Detector {
                 let (cx, cy) = ((c as usize) % ncx, (c as usize) / ncx);
                 let (xi, yi, ri) = (g.x[i], g.y[i], g.radius[i]);
                 mine.clear();
+                // Neighbour columns, wrapped around the period if periodic (ncx ≥ 3, so
+                // the three are distinct).
+                let (lo, hi) = if wrap {
+                    (cx + ncx - 1, cx + ncx + 1)
+                } else {
+                    (cx.saturating_sub(1), (cx + 1).min(ncx - 1))
+                };
                 for ny in cy.saturating_sub(1)..=(cy + 1).min(ncy - 1) {
-                    for nx in cx.saturating_sub(1)..=(cx + 1).min(ncx - 1) {
+                    for nx in (lo..=hi).map(|c| c % ncx) {
                         let cc = ny * ncx + nx;
                         for &j in &sorted[cell_start[cc] as usize..cell_start[cc + 1] as usize] {
                             if j as usize <= i || (polys && !g.is_disk(j as usize)) {
                                 continue;
                             }
                             let j_ = j as usize;
-                            let (dx, dy) = (g.x[j_] - xi, g.y[j_] - yi);
+                            let dx = min_image(g.x[j_] - xi, period);
+                            let dy = g.y[j_] - yi;
                             let reach = ri + g.radius[j_] + skin;
                             if dx * dx + dy * dy < reach * reach {
                                 mine.push(j);

@@ -20,11 +20,25 @@ pub struct DemParams {
     pub skin_fraction: f64,
     /// Global damping rate α (1/s) of seed eq. 5.57, c = α m; 0 = off (the default).
     pub global_damping: f64,
+    /// Periodic in x over [x0, x1) (`None`: not periodic). A grain leaving through one end
+    /// comes back through the other, and grains near the two ends touch through the period
+    /// (minimal image, [`min_image`]). Disks only; the walls are not repeated.
+    pub periodic_x: Option<[f64; 2]>,
+}
+
+/// The minimal image of a separation `dx` along a period of length `l`:
+/// dx − l · round(dx / l), in [−l/2, l/2]; `dx` itself without a period.
+#[inline(always)]
+pub fn min_image(dx: f64, l: Option<f64>) -> f64 {
+    match l {
+        Some(l) => dx - l * (dx / l).round(),
+        None => dx,
+    }
 }
 
 impl DemParams {
     /// Parameters with `grain` and `wall` laws, gravity, automatic step, λ = 0.1, skin 0.2 d_max,
-    /// no global damping.
+    /// no global damping, no period.
     pub fn new(grain: ContactParams, wall: ContactParams, gravity: [f64; 2]) -> Self {
         DemParams {
             grain,
@@ -34,6 +48,12 @@ impl DemParams {
             lambda: 0.1,
             skin_fraction: 0.2,
             global_damping: 0.0,
+            periodic_x: None,
         }
+    }
+
+    /// Length of the x period, if periodic.
+    pub fn period(&self) -> Option<f64> {
+        self.periodic_x.map(|[a, b]| b - a)
     }
 }

@@ -398,7 +398,7 @@ fn min_image(dx: f64, dy: f64, lx: f64, ly: f64, offset: f64) -> (f64, f64, f64)
     let ky = -(dy / ly).round();
     let dy = dy + ky * ly;
     let dx = dx + ky * offset;
-    (dx - lx * (dx / lx).round(), dy, ky)
+    (super::params::min_image(dx, Some(lx)), dy, ky)
 }
 
 /// A block mean of the recorded quantities.

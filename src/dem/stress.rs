@@ -16,6 +16,7 @@
 //! homogenised stress of the packing (the voids contribute nothing).
 
 use super::detect_rapier::WALL_BIT;
+use super::params::min_image;
 use super::solver::Dem;
 
 /// Love–Weber stress of every grain (Pa), row-major `[xx, xy, yx, yy]`, from the contact
@@ -38,7 +39,8 @@ pub fn grain_stress(dem: &Dem, thickness: f64) -> Vec<[f64; 4]> {
             continue;
         }
         let (i, j) = (pl.i[p] as usize, pl.j[p] as usize);
-        let (dx, dy) = (g.x[j] - g.x[i], g.y[j] - g.y[i]);
+        let dx = min_image(g.x[j] - g.x[i], dem.params().period());
+        let dy = g.y[j] - g.y[i];
         let d = (dx * dx + dy * dy).sqrt();
         let n = if d > 0.0 {
             [dx / d, dy / d]

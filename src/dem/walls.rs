@@ -1,7 +1,8 @@
-//! Fixed walls: half-planes (box sides, floor), straight line segments and convex polygons.
+//! Fixed walls: half-planes (box sides, floor), straight line segments, fixed disks (the bumps of
+//! a rough wall) and convex polygons.
 //!
-//! Planes and segments meet disks through the cell list ([`super::neighbours`]) with the
-//! distance below; polygon walls, and every wall a polygon grain meets, go through the rapier2d
+//! Planes, segments and disks meet disk grains through the cell list ([`super::neighbours`])
+//! with the distance below; polygon walls, and every wall a polygon grain meets, go through the rapier2d
 //! detector ([`super::detect_rapier`]).
 //!
 //! A wall reports, for a disk of centre **c**, the distance s from the centre to the wall and
@@ -27,6 +28,14 @@ pub enum Wall {
         a: [f64; 2],
         /// Second end.
         b: [f64; 2],
+    },
+    /// A fixed disk of radius `radius` centred at `centre` (one bump of a rough wall):
+    /// s = |**c** − **p**| − R_w, **n** = (**p** − **c**)/|**p** − **c**|.
+    Disk {
+        /// Centre.
+        centre: [f64; 2],
+        /// Radius (> 0).
+        radius: f64,
     },
     /// A solid convex polygon (an obstacle), `vertices[..n]` in world coordinates, counter-
     /// clockwise. Contacts with it are found by the rapier2d detector only; [`Wall::distance`]
@@ -103,11 +112,12 @@ impl Wall {
                 shift(a);
                 shift(b);
             }
+            Wall::Disk { centre, .. } => shift(centre),
             Wall::Polygon { vertices, n } => vertices[..*n as usize].iter_mut().for_each(shift),
         }
     }
 
-    /// Whether the cell list handles this wall for disks (planes and segments).
+    /// Whether the cell list handles this wall for disks (planes, segments and disks).
     pub fn is_straight(&self) -> bool {
         !matches!(self, Wall::Polygon { .. })
     }
@@ -139,6 +149,15 @@ impl Wall {
                     (0.0, [ey / l, -ex / l])
                 }
             }
+            Wall::Disk { centre, radius } => {
+                let (dx, dy) = (centre[0] - c[0], centre[1] - c[1]);
+                let d = (dx * dx + dy * dy).sqrt();
+                if d > 0.0 {
+                    (d - radius, [dx / d, dy / d])
+                } else {
+                    (-radius, [0.0, -1.0])
+                }
+            }
             Wall::Polygon { .. } => (f64::INFINITY, [0.0, 0.0]),
         }
     }
@@ -160,6 +179,14 @@ impl Wall {
                     return Err(crate::Error::config(
                         field,
                         "segment needs two distinct finite end points",
+                    ));
+                }
+            }
+            Wall::Disk { centre, radius } => {
+                if !(centre.iter().all(|v| v.is_finite()) && radius > 0.0 && radius.is_finite()) {
+                    return Err(crate::Error::config(
+                        field,
+                        format!("disk needs a finite centre and a radius > 0, got R = {radius}"),
                     ));
                 }
             }

@@ -100,6 +100,11 @@ pub const CASES: &[Case] = &[
         run: super::granular::validation::run,
     },
     Case {
+        name: "chute-bagnold",
+        description: "steady chute flow: velocity profile vs Bagnold's within 5 % in the bulk, exponent 3/2",
+        run: super::granular::chute::run,
+    },
+    Case {
         name: "rve-biaxial",
         description: "periodic volume vs wall-bounded biaxial test of one material: φ peak and critical within 2°",
         run: |f| checks_only(super::dem::rve_biaxial::validation(f)),

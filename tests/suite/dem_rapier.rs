@@ -214,12 +214,12 @@ fn detection_timing() {
     let touching = out.iter().filter(|c| c.delta > 0.0).count();
     let mut cl = Detector::new(skin);
     let (mut pl, mut wl) = (PairList::default(), WallList::default());
-    cl.build(&g, &walls, &mut pl, &mut wl);
+    cl.build(&g, &walls, None, &mut pl, &mut wl);
     let mut t_c = 0.0;
     for _ in 0..steps {
         jiggle(&mut g);
         let t = Instant::now();
-        cl.build(&g, &walls, &mut pl, &mut wl);
+        cl.build(&g, &walls, None, &mut pl, &mut wl);
         t_c += t.elapsed().as_secs_f64();
     }
     // What a system with a few polygons pays: every 100th grain a hexagon of the same size,

@@ -9,6 +9,7 @@
 mod common;
 
 mod architecture;
+mod chute;
 mod cli;
 mod collapse_study;
 mod conservation_properties;

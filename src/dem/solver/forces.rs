@@ -6,6 +6,7 @@
 use rayon::prelude::*;
 
 use super::*;
+use crate::dem::params::min_image;
 
 impl Dem {
     /// Steps 3–5: rebuild the lists if needed, evaluate all forces at the current positions
@@ -35,9 +36,15 @@ impl Dem {
         if self.moved {
             self.moved = false;
             self.wall_travel = 0.0;
+            if let Some([a, b]) = self.params.periodic_x {
+                for x in &mut self.grains.x {
+                    *x = a + (*x - a).rem_euclid(b - a);
+                }
+            }
             self.detector.build(
                 &self.grains,
                 &self.walls,
+                self.params.periodic_x,
                 &mut self.pairs,
                 &mut self.wall_pairs,
             );
@@ -71,6 +78,7 @@ impl Dem {
         let (pi, pj, first) = (&pl.i[..], &pl.j[..], &pl.first[..]);
         let (wg, ww, wfirst) = (&wl.grain[..], &wl.wall[..], &wl.first[..]);
         let grav = self.params.gravity;
+        let period = self.params.period();
         let alpha = self.params.global_damping;
         let empty: &[f64] = &[];
         let (lx, ly, lt) = match loads {
@@ -113,6 +121,7 @@ impl Dem {
             wg,
             ww,
             grav,
+            period,
             alpha,
             lx,
             ly,
@@ -446,6 +455,7 @@ struct ForceInputs<'a> {
     wg: &'a [u32],
     ww: &'a [u32],
     grav: [f64; 2],
+    period: Option<f64>,
     alpha: f64,
     lx: &'a [f64],
     ly: &'a [f64],
@@ -477,6 +487,7 @@ crate::exec::simd::multiversion! {
             wg,
             ww,
             grav,
+            period,
             alpha,
             lx,
             ly,
@@ -523,11 +534,11 @@ crate::exec::simd::multiversion! {
         let (ci, cj) = (&pi[p0..p0 + state.len()], &pj[p0..p0 + state.len()]);
         // Most pairs of a Verlet list are apart now and were apart at the last
         // evaluation: skip them in a tight first pass.
-        let cand = candidates(ci, cj, flags, x, y, rad, &mut s.cand[0]);
+        let cand = candidates(ci, cj, flags, x, y, rad, period, &mut s.cand[0]);
         for &k in cand {
             let k = k as usize;
             let (i, j) = (ci[k] as usize, cj[k] as usize);
-            let (dx, dy) = (x[j] - x[i], y[j] - y[i]);
+            let (dx, dy) = (min_image(x[j] - x[i], period), y[j] - y[i]);
             let (ri, rj) = (rad[i], rad[j]);
             let d2 = dx * dx + dy * dy;
             let rs = ri + rj;
@@ -648,6 +659,7 @@ crate::exec::simd::multiversion! {
 /// of a Verlet list are apart, in no predictable pattern). Kept out of line so that this loop
 /// has the registers to itself.
 #[inline(never)]
+#[allow(clippy::too_many_arguments)]
 fn candidates<'b>(
     pi: &[u32],
     pj: &[u32],
@@ -655,6 +667,7 @@ fn candidates<'b>(
     x: &[f64],
     y: &[f64],
     rad: &[f64],
+    period: Option<f64>,
     buf: &'b mut Vec<u32>,
 ) -> &'b [u32] {
     let n = pi.len().min(pj.len()).min(flags.len());
@@ -664,7 +677,7 @@ fn candidates<'b>(
     let mut c = 0;
     for k in 0..n {
         let (i, j) = (pi[k] as usize, pj[k] as usize);
-        let (dx, dy) = (x[j] - x[i], y[j] - y[i]);
+        let (dx, dy) = (min_image(x[j] - x[i], period), y[j] - y[i]);
         let rs = rad[i] + rad[j];
         let d2 = dx * dx + dy * dy;
         // A NaN distance counts as near, so the force loop sees (and propagates) it.

@@ -4,8 +4,12 @@
 //!
 //! * [`spec`]: the file's schema and its checks ([`GranularScenario`]);
 //! * [`run`]: settling, release, outlets and outputs ([`run::run_granular`]);
-//! * [`validation`]: the `silo-beverloo` case (discharge rate against orifice width).
+//! * [`profile`]: the time-averaged solid fraction and velocity across y (`profile.csv`);
+//! * [`validation`]: the `silo-beverloo` case (discharge rate against orifice width);
+//! * [`chute`]: the `chute-bagnold` case (velocity profile down a rough incline).
 
+pub mod chute;
+pub mod profile;
 pub mod run;
 pub mod spec;
 pub mod validation;

@@ -6,7 +6,8 @@
 //! * `timeseries.csv`: `t` (s after the release), `grains` (left), `discharged` (grains
 //!   removed by the outlets since the release), `discharged_mass` (kg), `kinetic_energy` (J,
 //!   translational and rotational), `contacts` (touching pairs);
-//! * `summary.json` ([`GranularSummary`]).
+//! * `summary.json` ([`GranularSummary`]);
+//! * `profile.csv` when the scenario has a `[profile]` ([`Profile::write`]).
 //!
 //! Outlets are applied every [`OUTLET_STEPS`] steps: a grain whose centre is inside one is
 //! removed ([`Dem::remove_grains`]), its mass added to the discharge.
@@ -21,6 +22,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use super::profile::Profile;
 use super::spec::{DerivedGranular, GranularScenario};
 use crate::analysis::powerlaw::linear_fit;
 use crate::dem::{Dem, Grains};
@@ -85,6 +87,8 @@ struct State {
     settle_time: Option<f64>,
     /// (t, discharged mass) per row, for the rate.
     history: Vec<(f64, f64)>,
+    /// The `[profile]` sums, if asked for.
+    profile: Option<Profile>,
     row: u64,
     frame: usize,
     series_bytes: u64,
@@ -268,6 +272,7 @@ pub fn run_granular(
                 discharged_mass: 0.0,
                 settle_time: s.settle.map(|_| settle_time),
                 history: Vec::new(),
+                profile: s.profile.map(Profile::new),
                 row: 0,
                 frame: 0,
                 series_bytes: 0,
@@ -303,6 +308,9 @@ pub fn run_granular(
                 touching,
             ])?;
             st.history.push((t, st.discharged_mass));
+            if let Some(p) = st.profile.as_mut().filter(|p| p.due(t)) {
+                p.sample(&st.dem.grains);
+            }
             let empty = st.dem.grains.is_empty();
             let drained = s
                 .time
@@ -370,6 +378,9 @@ pub fn run_granular(
         dt,
         wall_time_s: st.wall_time_s + t_run.elapsed().as_secs_f64(),
     };
+    if let Some(p) = &st.profile {
+        p.write(&out.join("profile.csv"))?;
+    }
     write_json(&out.join("summary.json"), &summary)?;
     crate::io::checkpoint::remove_all(out)?;
     Ok(summary)

@@ -16,6 +16,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::dem::packing::{SizeDistribution, SplitMix64};
+use crate::dem::params::min_image;
 use crate::dem::{DemParams, Grains, TimeStep, Wall};
 use crate::io::VtkFormat;
 use crate::lbm::obstacle::Shape;
@@ -41,6 +42,13 @@ pub struct GranularScenario {
     pub gravity: [f64; 2],
     /// Seed of the size draw and the lattice jitter of the filled regions.
     pub seed: u64,
+    /// Periodic in x over [x0, x1) (m), optional: a grain leaving through one end comes back
+    /// through the other and grains touch across the ends (a chute, a shear flow). Disks
+    /// only; the filled regions and listed grains must lie inside the period, and rows of
+    /// `bumps` are repeated across its ends (other walls are not). At least 3 (d_max + skin)
+    /// long.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub periodic_x: Option<[f64; 2]>,
     /// Grain sizes and material.
     pub grains: GrainsSpec,
     /// Grain–grain contact law.
@@ -59,6 +67,9 @@ pub struct GranularScenario {
     /// discharged.
     #[serde(default)]
     pub outlet: Vec<OutletSpec>,
+    /// A time-averaged profile across y (`[profile]`, optional): written to `profile.csv`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<ProfileSpec>,
     /// Settling before the release (`[settle]`, optional: without it the grains start as
     /// given, at t = 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -102,10 +113,13 @@ pub struct GrainSpec {
     pub angular_velocity: f64,
 }
 
-/// A wall: exactly one of `segment`, `polygon`, `plane`.
+/// A wall: exactly one of `segment`, `polygon`, `plane`, `bumps`.
 #[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WallSpec {
+    /// A rough wall: a row of fixed disks (see [`BumpsSpec`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bumps: Option<BumpsSpec>,
     /// A line segment between two points (m), both sides solid.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub segment: Option<[[f64; 2]; 2]>,
@@ -121,6 +135,39 @@ pub struct WallSpec {
     /// A gate: in place while the grains settle, removed at the release.
     #[serde(default)]
     pub gate: bool,
+}
+
+/// A rough wall: `count` fixed disks of diameter `diameter` with centres evenly spaced along
+/// the segment from `from` to `to`, at `from + (k + ½)(to − from)/count`, k = 0 … count − 1
+/// (so rows laid end to end, or across a whole period, keep the spacing). A grain meets them
+/// with the wall contact law.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BumpsSpec {
+    /// Start of the row (m).
+    pub from: [f64; 2],
+    /// End of the row (m).
+    pub to: [f64; 2],
+    /// Diameter of each disk (m).
+    pub diameter: f64,
+    /// Number of disks (1–100 000).
+    pub count: u32,
+}
+
+/// A profile across y, averaged over time from `start` to the end of the run: the grains whose
+/// centre lies in `rectangle` are binned by the height of their centre into `bins` equal
+/// slices; per slice the solid fraction φ = Σ (area of the disk within the slice) / (slice
+/// area) and the area-weighted mean velocity (u, v) = Σ A_ib **v**_i / Σ A_ib, sampled at
+/// every time-series row.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ProfileSpec {
+    /// Lower-left and upper-right corners (m).
+    pub rectangle: [[f64; 2]; 2],
+    /// Number of slices (1–10 000).
+    pub bins: u32,
+    /// Start of the average (s after the release).
+    pub start: f64,
 }
 
 /// A half-plane wall.
@@ -247,7 +294,30 @@ impl GranularScenario {
             grains.vy[i] = s.velocity[1];
             grains.omega[i] = s.angular_velocity;
         }
-        check_listed_apart(&grains, first_listed)?;
+        let period = self.periodic_x.map(|[a, b]| b - a);
+        if let Some([a, b]) = self.periodic_x {
+            finite("periodic_x", &[a, b])?;
+            if b <= a {
+                return Err(Error::config(
+                    "periodic_x",
+                    format!("must be [x0, x1] with x1 > x0, got [{a}, {b}]"),
+                ));
+            }
+            if let Some(k) = (0..grains.len()).find(|&k| {
+                grains.x[k] - grains.radius[k] < a - 1e-12 * (b - a)
+                    || grains.x[k] + grains.radius[k] > b + 1e-12 * (b - a)
+            }) {
+                return Err(Error::config(
+                    "periodic_x",
+                    format!(
+                        "grain {k} at x = {:.6e} m is not inside the period [{a}, {b}] (the \
+                         [[fill]] regions and [[grain]] entries must lie within it)",
+                        grains.x[k]
+                    ),
+                ));
+            }
+        }
+        check_listed_apart(&grains, first_listed, period)?;
         if grains.is_empty() {
             return Err(Error::config(
                 "fill",
@@ -293,8 +363,24 @@ impl GranularScenario {
                 ));
             }
         }
+        if let Some(p) = &self.profile {
+            rectangle("profile.rectangle", p.rectangle)?;
+            if !(1..=10_000).contains(&p.bins) {
+                return Err(Error::config(
+                    "profile.bins",
+                    format!("must be in 1–10 000, got {}", p.bins),
+                ));
+            }
+            if !(p.start >= 0.0 && p.start < t.end) {
+                return Err(Error::config(
+                    "profile.start",
+                    format!("must be in [0, time.end = {}) s, got {}", t.end, p.start),
+                ));
+            }
+        }
         let mut params = DemParams::new(grain, wall, self.gravity);
         params.lambda = t.lambda;
+        params.periodic_x = self.periodic_x;
         let time_step = TimeStep::of_grains(&params, &grains).map_err(|e| e.within("time"))?;
         Ok(DerivedGranular {
             params,
@@ -392,6 +478,27 @@ impl GranularScenario {
         let (mut walls, mut gates) = (Vec::new(), Vec::new());
         for (k, w) in self.wall.iter().enumerate() {
             let field = format!("wall[{k}]");
+            if let Some(b) = &w.bumps {
+                if w.segment.is_some() || w.polygon.is_some() || w.plane.is_some() {
+                    return Err(Error::config(
+                        field,
+                        "give exactly one of `segment`, `polygon`, `plane` and `bumps`",
+                    ));
+                }
+                if w.velocity.is_some() {
+                    return Err(Error::config(
+                        format!("{field}.velocity"),
+                        "only segments and planes that stay after the release can move",
+                    ));
+                }
+                let row = self.bumps(&format!("{field}.bumps"), b)?;
+                if w.gate {
+                    gates.extend(row);
+                } else {
+                    walls.extend(row.into_iter().map(|d| (d, None)));
+                }
+                continue;
+            }
             let wall = match (&w.segment, &w.polygon, &w.plane) {
                 (&Some([a, b]), None, None) => {
                     finite(&format!("{field}.segment"), &[a[0], a[1], b[0], b[1]])?;
@@ -422,7 +529,7 @@ impl GranularScenario {
                 _ => {
                     return Err(Error::config(
                         field,
-                        "give exactly one of `segment`, `polygon` and `plane`",
+                        "give exactly one of `segment`, `polygon`, `plane` and `bumps`",
                     ))
                 }
             };
@@ -450,13 +557,55 @@ impl GranularScenario {
         }
         Ok((walls, gates))
     }
+
+    /// The disks of a row of bumps (named `field`), with their images across the ends of the
+    /// period when periodic: a disk within R_b + 2 d_max of one end is repeated one period
+    /// beyond the other.
+    fn bumps(&self, field: &str, b: &BumpsSpec) -> Result<Vec<Wall>> {
+        finite(&format!("{field}.from"), &b.from)?;
+        finite(&format!("{field}.to"), &b.to)?;
+        positive(&format!("{field}.diameter"), b.diameter)?;
+        if !(1..=100_000).contains(&b.count) {
+            return Err(Error::config(
+                format!("{field}.count"),
+                format!("must be in 1–100 000, got {}", b.count),
+            ));
+        }
+        let n = f64::from(b.count);
+        let r = 0.5 * b.diameter;
+        let margin = r + 2.0 * self.grains.d_max;
+        let mut row = Vec::new();
+        for k in 0..b.count {
+            let t = (f64::from(k) + 0.5) / n;
+            let c = [
+                b.from[0] + t * (b.to[0] - b.from[0]),
+                b.from[1] + t * (b.to[1] - b.from[1]),
+            ];
+            row.push(Wall::Disk {
+                centre: c,
+                radius: r,
+            });
+            if let Some([x0, x1]) = self.periodic_x {
+                for (near, shift) in [(c[0] - x0 < margin, x1 - x0), (x1 - c[0] < margin, x0 - x1)]
+                {
+                    if near {
+                        row.push(Wall::Disk {
+                            centre: [c[0] + shift, c[1]],
+                            radius: r,
+                        });
+                    }
+                }
+            }
+        }
+        Ok(row)
+    }
 }
 
 /// Refuse a listed grain (index `first` on) that overlaps another grain, listed or filled.
-fn check_listed_apart(g: &Grains, first: usize) -> Result<()> {
+fn check_listed_apart(g: &Grains, first: usize, period: Option<f64>) -> Result<()> {
     for i in first..g.len() {
         for j in 0..i {
-            let d = (g.x[i] - g.x[j]).hypot(g.y[i] - g.y[j]);
+            let d = min_image(g.x[i] - g.x[j], period).hypot(g.y[i] - g.y[j]);
             if d < g.radius[i] + g.radius[j] {
                 let other = match j.checked_sub(first) {
                     Some(k) => format!("grain[{k}]"),

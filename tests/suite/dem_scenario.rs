@@ -53,7 +53,7 @@ fn tiny() -> String {
 kind = "dem"
 name = "tiny"
 description = "test"
-gravity = 9.81
+gravity = [0.0, -9.81]
 seed = 1
 [grains]
 d_min = 4.0e-3
@@ -149,7 +149,12 @@ fn bad_values_are_refused_with_the_field_named() {
     }
     // Misspelt or missing keys are refused by the parser (no silent defaults).
     assert!(DemScenario::from_toml(&base.replace("thickness", "thicknes")).is_err());
-    assert!(DemScenario::from_toml(&base.replace("gravity = 9.81\n", "")).is_err());
+    assert!(DemScenario::from_toml(&base.replace("gravity = [0.0, -9.81]\n", "")).is_err());
+    // Gravity is a vector that must point into the floor.
+    let up =
+        DemScenario::from_toml(&base.replace("gravity = [0.0, -9.81]", "gravity = [0.0, 9.81]"));
+    let e = up.unwrap().derive().map(|_| ()).unwrap_err().to_string();
+    assert!(e.contains("gravity") && e.contains("g_y < 0"), "{e}");
 }
 
 /// `deposition.settling_velocity` v_s deposits against the drag α = g/v_s and then relaxes under

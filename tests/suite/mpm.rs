@@ -365,8 +365,14 @@ fn musl_remap_keeps_the_floor_contact_of_the_update() {
 /// The a = 0.5 column of `mpm_a0.5.toml` as a linear elastic body (the file's density,
 /// E = 1.98 MPa and ν = 0.23) on frictionless walls, with `initial` as its `[initial]` table.
 fn elastic_column(initial: &str) -> granflow::mpm::Mpm {
+    elastic_column_under(initial, [0.0, -9.81])
+}
+
+/// [`elastic_column`] under the gravity `g` (m/s²).
+fn elastic_column_under(initial: &str, g: [f64; 2]) -> granflow::mpm::Mpm {
     let text = std::fs::read_to_string(model("0.5")).unwrap();
     let mut table: toml::Table = text.parse().unwrap();
+    table["gravity"] = toml::Value::Array(vec![g[0].into(), g[1].into()]);
     table["material"] = toml::Value::Table(
         "model = \"linear_elastic\"\ndensity = 1925.0\nyoungs_modulus = 1.98e6\npoisson_ratio = 0.23"
             .parse()
@@ -451,6 +457,43 @@ fn an_initial_velocity_moves_the_column_with_its_momentum() {
         "{moved} m in {} s",
         mpm.time()
     );
+}
+
+/// Gravity as a vector: the column on frictionless walls under g = (1.5, −9.81) m/s² (a plane
+/// tilted by 8.7°, downhill away from the back wall), started at its geostatic stress, slides
+/// as a whole, its x momentum M g_x t to 1e-9 relative after 200 steps (nothing but gravity
+/// pushes along x), while a
+/// gravity that does not point into the floor is refused naming `gravity`.
+#[test]
+fn a_tilted_gravity_slides_the_column_down_the_plane() {
+    // Started at its geostatic stress under g_y: the x component then accelerates it rigidly
+    // (from zero stress it would bulge and push off the back wall).
+    let mut mpm = elastic_column_under(
+        "stress = [0.0, \"-1925*9.81*(0.0275 - y)\", 0.0, \"-0.23*1925*9.81*(0.0275 - y)\"]",
+        [1.5, -9.81],
+    );
+    mpm.steps(200).unwrap();
+    let p = &mpm.points;
+    let mass: f64 = p.mass.iter().sum();
+    let momentum: f64 = p.mass.iter().zip(&p.vel).map(|(m, v)| m * v[0]).sum();
+    let expected = mass * 1.5 * mpm.time();
+    assert!(
+        (momentum / expected - 1.0).abs() < 1e-9,
+        "{momentum} against {expected}"
+    );
+    let text = std::fs::read_to_string(model("0.5")).unwrap();
+    for (g, kind) in [("[0.0, 9.81]", "mpm"), ("[9.81, 0.0]", "mpm")] {
+        let e = MpmScenario::from_toml(
+            &text.replace("gravity = [0.0, -9.81]", &format!("gravity = {g}")),
+        )
+        .and_then(|s| s.build().map(|_| ()))
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("gravity") && e.contains("g_y < 0"),
+            "{kind} {g}: {e}"
+        );
+    }
 }
 
 /// `[initial]` expressions are checked like the fluid's: a bad one is refused naming its key,

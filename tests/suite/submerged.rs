@@ -190,7 +190,7 @@ fn tiny_collapse_runs_and_its_outputs_agree() {
     // The pressure field of the frame: pressure − excess = ρ_f g (depth − y), hydrostatic.
     let total = vti_array(&out.join(f1), "pressure");
     let c = 10 * nx + 7;
-    let hyd = s.fluid.density * s.gravity * (s.fluid.depth - 10.5 * dx);
+    let hyd = -s.fluid.density * s.gravity[1] * (s.fluid.depth - 10.5 * dx);
     assert!((total[c] - p[c] - hyd).abs() <= 1e-9 * hyd);
 
     // The liquid resists the spreading: over the first 2 τ_c the grains move right, so the

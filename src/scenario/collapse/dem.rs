@@ -31,7 +31,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::{run_resumable, steps_per_row, Column, Plan, Row, Tally};
+use super::{collapse_gravity, rest_scale, run_resumable, steps_per_row, Column, Plan, Row, Tally};
 use crate::analysis::runout::CollapseOutcome;
 use crate::dem::detect_rapier::WALL_BIT;
 use crate::dem::packing::deposit_column;
@@ -436,11 +436,12 @@ pub fn column(scenario: &DemScenario) -> Result<(DemColumn, Plan<'_>)> {
     dem.refresh_forces();
     let e0 = dem.energy();
     let ts = &scenario.time;
+    let g = collapse_gravity(scenario.gravity)?;
     let plan = plan(
         &scenario.name,
         [scenario.column.width, deposit.height],
-        scenario.gravity,
-        e0.potential,
+        g,
+        rest_scale(&dem.grains.mass, &dem.grains.y, g),
         ts,
         scenario.vtk,
     );
@@ -474,11 +475,12 @@ pub fn run_resumable_collapse(
     control: Control,
     progress: Progress,
 ) -> Result<CollapseSummary> {
+    let g = collapse_gravity(scenario.gravity)?;
     let plan_of = |h_i, potential| {
         plan(
             &scenario.name,
             [scenario.column.width, h_i],
-            scenario.gravity,
+            g,
             potential,
             &scenario.time,
             scenario.vtk,

@@ -342,3 +342,27 @@ fn run_loop<C: Column>(
 pub(crate) fn steps_per_row(interval_tc: f64, tau_c: f64, dt: f64) -> u64 {
     ((interval_tc * tau_c / dt).ceil() as u64).max(1)
 }
+
+/// |**g**| (m/s²) of a collapse file's `gravity` = [g_x, g_y], checked: finite and pointing into
+/// the floor (g_y < 0; the floor is y = 0). A tilted **g** = |g| (sin θ, −cos θ) is a collapse on
+/// a plane inclined by θ, downhill towards +x for θ > 0.
+pub fn collapse_gravity(g: [f64; 2]) -> Result<f64> {
+    if !(g.iter().all(|v| v.is_finite()) && g[1] < 0.0) {
+        return Err(crate::Error::config(
+            "gravity",
+            format!(
+                "a column collapse needs a finite gravity pointing into the floor (g_y < 0), \
+                 got [{}, {}]",
+                g[0], g[1]
+            ),
+        ));
+    }
+    Ok(g[0].hypot(g[1]))
+}
+
+/// The rest test's energy scale (J): Σ m |**g**| y, the potential energy above the floor of
+/// masses `m` at heights `y` under gravity of magnitude `g` (for gravity along −y, the
+/// potential energy itself).
+pub fn rest_scale(m: &[f64], y: &[f64], g: f64) -> f64 {
+    m.iter().zip(y).map(|(m, y)| m * g * y).sum()
+}

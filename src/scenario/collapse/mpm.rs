@@ -28,7 +28,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::{run_resumable, steps_per_row, Column, Plan, Row, Tally};
+use super::{rest_scale, run_resumable, steps_per_row, Column, Plan, Row, Tally};
 use crate::analysis::runout::CollapseOutcome;
 use crate::coupling::RveMaterial;
 use crate::dem::periodic_cell::PeriodicCell;
@@ -445,7 +445,7 @@ fn plan(scenario: &MpmScenario, height: f64, potential: f64) -> Plan<'_> {
         name: &scenario.name,
         l_i: scenario.column.width,
         h_i: height,
-        gravity: scenario.gravity,
+        gravity: scenario.gravity[0].hypot(scenario.gravity[1]),
         potential,
         series_interval_tc: ts.series_interval_tc,
         frame_interval_tc: ts.frame_interval_tc,
@@ -463,7 +463,9 @@ fn column_of<'a, M: PointOutput>(
     height: f64,
     tau_c: f64,
 ) -> (MpmColumn<M>, Plan<'a>) {
-    let plan = plan(scenario, height, mpm.energy().potential);
+    let g = scenario.gravity[0].hypot(scenario.gravity[1]);
+    let y: Vec<f64> = mpm.points.pos.iter().map(|p| p[1]).collect();
+    let plan = plan(scenario, height, rest_scale(&mpm.points.mass, &y, g));
     let series_steps = steps_per_row(scenario.time.series_interval_tc, tau_c, mpm.dt());
     let e0 = mpm.energy();
     (

@@ -37,7 +37,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::dem::{energy_values, plan, shape, write_frame, Shape};
-use super::{run_resumable, Column, Plan, Resumable, Row, Tally};
+use super::{rest_scale, run_resumable, Column, Plan, Resumable, Row, Tally};
 use crate::analysis::runout::CollapseOutcome;
 use crate::coupling::{
     reduced_gravity, CellForces, Coupled, CoupledFluid, CoupledFluidState, DiskCover, Exchange,
@@ -400,7 +400,7 @@ impl<T: Real> Column for SubmergedColumn<'_, T> {
             pvd,
         )?;
         let name = format!("fluid_{k:06}.vti");
-        let hydro = sc.fluid.density * sc.gravity;
+        let hydro = -sc.fluid.density * sc.gravity[1];
         self.fields.write(
             &self.derived.units,
             hydro,
@@ -430,7 +430,7 @@ impl<T: Real> Column for SubmergedColumn<'_, T> {
     fn summary(&self, collapse: CollapseOutcome) -> SubmergedSummary {
         let (sc, d, c) = (self.scenario, self.derived, &self.coupled);
         let (f, u) = (&sc.fluid, d.units);
-        let tau_c = (self.h_i / sc.gravity).sqrt();
+        let tau_c = (self.h_i / sc.gravity[0].hypot(sc.gravity[1])).sqrt();
         let sound = u.dx / (3f64.sqrt() * u.dt);
         let t_a = 2.0 * sc.column.box_length.max(f.depth) / sound;
         let mean_until = |t1: f64| {
@@ -465,7 +465,7 @@ impl<T: Real> Column for SubmergedColumn<'_, T> {
                 max_mach: self.max_mach,
                 pressure_scale: (sc.grains.density - f.density)
                     * self.packing_fraction
-                    * sc.gravity
+                    * -sc.gravity[1]
                     * self.h_i,
                 acoustic_period_tc: t_a / tau_c,
                 pore_pressure_early_mean: mean_until(t_a),
@@ -496,21 +496,24 @@ pub fn column<'a, T: Real>(
             ),
         ));
     }
-    let gmag = scenario.gravity;
     let walls = vec![
         Wall::floor(0.0),
         Wall::left(0.0),
         Wall::right(scenario.column.box_length),
     ];
     let mut params = d.dem.params.clone();
-    params.gravity = reduced_gravity([0.0, -gmag], f.density, scenario.grains.density);
+    params.gravity = reduced_gravity(scenario.gravity, f.density, scenario.grains.density);
     let dem = Dem::new(deposit.grains, walls, params)?;
     let mut column = assemble(scenario, d, dem, h_i)?;
     column.packing_fraction = deposit.packing_fraction;
     column.deposition_wall_time_s = deposition_wall_time_s;
     column.coupled.solid.refresh_forces();
     column.e0 = column.coupled.solid.energy();
-    let plan = submerged_plan(scenario, h_i, column.e0.potential);
+    // The rest test's scale under the reduced gravity the grains feel.
+    let solid = &column.coupled.solid;
+    let g_red = solid.params().gravity[0].hypot(solid.params().gravity[1]);
+    let potential = rest_scale(&solid.grains.mass, &solid.grains.y, g_red);
+    let plan = submerged_plan(scenario, h_i, potential);
     Ok((column, plan))
 }
 
@@ -521,7 +524,7 @@ fn submerged_plan(scenario: &SubmergedScenario, h_i: f64, potential: f64) -> Pla
     plan(
         &scenario.name,
         [l_i, h_i],
-        scenario.gravity,
+        scenario.gravity[0].hypot(scenario.gravity[1]),
         potential,
         &scenario.time,
         scenario.vtk,
@@ -537,7 +540,7 @@ fn assemble<'a, T: Real>(
     h_i: f64,
 ) -> Result<SubmergedColumn<'a, T>> {
     let l_i = scenario.column.width;
-    let gmag = scenario.gravity;
+    let gmag = scenario.gravity[0].hypot(scenario.gravity[1]);
     let [nx, ny] = d.cells;
     let u = d.units;
     let edges = Edges::closed();

@@ -23,6 +23,7 @@ use crate::dem::contact::ContactParams;
 use crate::dem::packing::{ColumnSpec, SizeDistribution};
 use crate::dem::{DemParams, TimeStep};
 use crate::io::VtkFormat;
+use crate::scenario::collapse::collapse_gravity;
 use crate::scenario::{non_negative, positive, Kind, ScenarioFile};
 use crate::{Error, Result};
 
@@ -36,8 +37,9 @@ pub struct DemScenario {
     pub name: String,
     /// One line saying what the case is (and how it was scaled).
     pub description: String,
-    /// Gravitational acceleration g (m/s², acting along −y).
-    pub gravity: f64,
+    /// Gravitational acceleration **g** = [g_x, g_y] (m/s²), pointing into the floor (g_y < 0);
+    /// tilted, |g| (sin θ, −cos θ), for a collapse on a plane inclined by θ.
+    pub gravity: [f64; 2],
     /// Seed of the size draw and the deposition lattice.
     pub seed: u64,
     /// Grain sizes and material.
@@ -245,7 +247,7 @@ impl DemScenario {
     /// deposition friction or rolling friction < 0; a settling velocity ≤ 0; and (through
     /// [`crate::dem::Dem::new`] later) a step above λ Δt_cr.
     pub fn derive(&self) -> Result<DerivedDem> {
-        positive("gravity", self.gravity)?;
+        let g_abs = collapse_gravity(self.gravity)?;
         let g = &self.grains;
         g.check()?;
         let c = &self.column;
@@ -313,7 +315,7 @@ impl DemScenario {
                 format!("the column holds only {n} grains; make it larger"),
             ));
         }
-        let mut params = DemParams::new(grain, wall, [0.0, -self.gravity]);
+        let mut params = DemParams::new(grain, wall, self.gravity);
         params.lambda = t.lambda;
         // The step of the smallest grain: what the run will take (from the actual grains).
         let time_step = TimeStep::of_disk(&params, g.d_min, g.density * g.thickness)
@@ -321,7 +323,7 @@ impl DemScenario {
         let mut dep = params.clone();
         dep.grain.friction = d.friction;
         dep.grain.rolling_friction = d.rolling_friction;
-        dep.global_damping = d.settling_velocity.map_or(0.0, |v| self.gravity / v);
+        dep.global_damping = d.settling_velocity.map_or(0.0, |v| g_abs / v);
         let relax =
             (dep.grain != params.grain || dep.global_damping != 0.0).then(|| params.clone());
         let column = ColumnSpec {
@@ -343,7 +345,7 @@ impl DemScenario {
             column,
             grains: n,
             target_height,
-            target_tau_c: (target_height / self.gravity).sqrt(),
+            target_tau_c: (target_height / g_abs).sqrt(),
             time_step,
         })
     }

@@ -58,7 +58,7 @@ pub fn run(scenario: &MpmScenario, points: usize, steps: u64, repeats: usize) ->
     let h = scenario.mpm.cell_size;
     let c = (material.p_wave_modulus() / material.density()).sqrt();
     let dt = scenario.time.dt.unwrap_or(scenario.mpm.courant * h / c);
-    let gdot = (scenario.gravity / d.height).sqrt();
+    let gdot = (scenario.gravity[0].hypot(scenario.gravity[1]) / d.height).sqrt();
     let de = [0.0, 0.0, 0.5 * gdot * dt];
     let (start, s0) = material.start();
     let mut samples = Vec::with_capacity(repeats);

@@ -26,6 +26,7 @@ use crate::mpm::material::{LinearElastic, MaterialModel, MohrCoulomb, MuIMohrCou
 use crate::mpm::points::Points;
 use crate::mpm::shape::ShapeKind;
 use crate::mpm::solver::{Mpm, MpmParams, Scheme, Transfer};
+use crate::scenario::collapse::collapse_gravity;
 use crate::scenario::dem::spec::{ContactSpec, GrainsSpec};
 use crate::scenario::mpm::initial::MpmInitialSpec;
 use crate::scenario::{non_negative, positive, Kind, ScenarioFile};
@@ -41,8 +42,9 @@ pub struct MpmScenario {
     pub name: String,
     /// One line saying what the case is (and how it was scaled).
     pub description: String,
-    /// Gravitational acceleration g (m/s², acting along −y).
-    pub gravity: f64,
+    /// Gravitational acceleration **g** = [g_x, g_y] (m/s²), pointing into the floor (g_y < 0);
+    /// tilted, |g| (sin θ, −cos θ), for a collapse on a plane inclined by θ.
+    pub gravity: [f64; 2],
     /// The continuum's constitutive law.
     pub material: MaterialSpec,
     /// Column and box geometry.
@@ -520,7 +522,7 @@ impl ScenarioFile for MpmScenario {
 impl MpmScenario {
     /// Check every value and derive the set-up (see the module doc for what is refused).
     pub fn derive(&self) -> Result<DerivedMpm> {
-        positive("gravity", self.gravity)?;
+        let g_abs = collapse_gravity(self.gravity)?;
         let material = self.material.build()?;
         if let Some(initial) = &self.initial {
             initial.compile()?;
@@ -627,7 +629,7 @@ impl MpmScenario {
         Ok(DerivedMpm {
             material,
             height,
-            tau_c: (height / self.gravity).sqrt(),
+            tau_c: (height / g_abs).sqrt(),
             points: wc * hc * n * n,
             cells: [cells_x as usize + 4, hc + 6],
             dt_cfl,
@@ -648,15 +650,16 @@ impl MpmScenario {
         Ok((self.build_with(material, &d, |_| [0.0; 4])?, d))
     }
 
-    /// The geostatic stress of the column at rest, σ_yy = −ρ g (H − y), σ_xx = K₀ σ_yy,
-    /// σ_zz = ½(σ_xx + σ_yy), for a bulk density ρ.
+    /// The geostatic stress of the column at rest, σ_yy = −ρ |g_y| (H − y), σ_xx = K₀ σ_yy,
+    /// σ_zz = ½(σ_xx + σ_yy), for a bulk density ρ (under a tilted gravity, the stress of
+    /// its normal component alone: the column is not at rest then).
     pub fn geostatic(
         &self,
         d: &DerivedMpm,
         density: f64,
         k0: f64,
     ) -> impl Fn([f64; 2]) -> crate::mpm::material::Stress + Sync {
-        let (g, height) = (self.gravity, d.height);
+        let (g, height) = (-self.gravity[1], d.height);
         move |x| {
             let yy = -density * g * (height - x[1]);
             [k0 * yy, yy, 0.0, 0.5 * (1.0 + k0) * yy]
@@ -704,7 +707,7 @@ impl MpmScenario {
         let params = MpmParams {
             shape: self.mpm.shape,
             scheme: self.mpm.scheme,
-            gravity: [0.0, -self.gravity],
+            gravity: self.gravity,
             courant: self.mpm.courant,
             dt: self.time.dt,
             damping: self.mpm.damping,

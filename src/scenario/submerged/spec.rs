@@ -25,6 +25,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::io::VtkFormat;
 use crate::scale::substeps;
+use crate::scenario::collapse::collapse_gravity;
 use crate::scenario::dem::{
     ColumnGeometry, ContactSpec, DemScenario, DemTimeSpec, DepositionSpec, DerivedDem, GrainsSpec,
 };
@@ -43,8 +44,9 @@ pub struct SubmergedScenario {
     pub name: String,
     /// One line saying what the case is (and how it was scaled).
     pub description: String,
-    /// Gravitational acceleration g (m/s², acting along −y).
-    pub gravity: f64,
+    /// Gravitational acceleration **g** = [g_x, g_y] (m/s²), pointing into the floor (g_y < 0);
+    /// tilted, |g| (sin θ, −cos θ), for a collapse on a plane inclined by θ.
+    pub gravity: [f64; 2],
     /// Seed of the size draw and the deposition lattice.
     pub seed: u64,
     /// Grain sizes and material.
@@ -248,7 +250,7 @@ impl SubmergedScenario {
         }
         let units = lattice_units("coupling", c.dx, c.tau, c.dt, f.viscosity, f.density)?;
         let tau = units.tau;
-        let g_red = (1.0 - f.density / self.grains.density) * self.gravity;
+        let g_red = (1.0 - f.density / self.grains.density) * collapse_gravity(self.gravity)?;
         let u_ref = (g_red * dem.target_height).sqrt();
         let mach = units.velocity_to_lattice(u_ref) / CS2.sqrt();
         if mach > MAX_MACH {

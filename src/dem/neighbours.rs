@@ -217,13 +217,20 @@ impl Detector {
                 mine.clear();
                 // Neighbour columns, wrapped around the period if periodic (ncx ≥ 3, so
                 // the three are distinct).
-                let (lo, hi) = if wrap {
-                    (cx + ncx - 1, cx + ncx + 1)
+                let mut cols = [cx; 3];
+                let nc = if wrap {
+                    cols = [(cx + ncx - 1) % ncx, cx, (cx + 1) % ncx];
+                    3
                 } else {
-                    (cx.saturating_sub(1), (cx + 1).min(ncx - 1))
+                    let lo = cx.saturating_sub(1);
+                    let hi = (cx + 1).min(ncx - 1);
+                    for (k, c) in (lo..=hi).enumerate() {
+                        cols[k] = c;
+                    }
+                    hi - lo + 1
                 };
                 for ny in cy.saturating_sub(1)..=(cy + 1).min(ncy - 1) {
-                    for nx in (lo..=hi).map(|c| c % ncx) {
+                    for &nx in &cols[..nc] {
                         let cc = ny * ncx + nx;
                         for &j in &sorted[cell_start[cc] as usize..cell_start[cc + 1] as usize] {
                             if j as usize <= i || (polys && !g.is_disk(j as usize)) {

@@ -5,7 +5,6 @@
 //! `chute-bagnold` runs at the test size (heavy tier).
 
 use granflow::dem::{ContactParams, Dem, DemParams, Grains};
-use granflow::report::Fidelity;
 use granflow::scenario::granular::GranularScenario;
 use granflow::scenario::ScenarioFile;
 
@@ -204,12 +203,5 @@ fn the_chute_model_checks_and_bad_periodic_input_is_refused() {
 #[test]
 #[ignore = "heavy tier (≈ 100 s on 2 cores): cargo test -- --ignored"]
 fn chute_bagnold_at_the_test_size() {
-    let report = granflow::scenario::validation::run("chute-bagnold", Fidelity::Test).unwrap();
-    for c in &report.checks {
-        println!(
-            "{} {} {:.4e} (ref {:.4e} ± {:.1e})",
-            c.case, c.quantity, c.value, c.reference, c.tolerance
-        );
-    }
-    assert!(report.checks.iter().all(|c| c.pass));
+    crate::common::assert_passes("chute-bagnold");
 }

@@ -3,27 +3,9 @@
 
 use granflow::coupling::CoupledFluid;
 use granflow::lbm::{CollisionModel, Edge, Edges, FluidModel, Lattice, Lbm, MrtRates, Obstacles};
-use granflow::report::Fidelity;
-use granflow::scenario::validation::run;
 use granflow::units::Units;
 
-fn assert_passes(case: &str) {
-    let report = run(case, Fidelity::Test).expect(case);
-    assert!(!report.checks.is_empty());
-    for c in &report.checks {
-        println!(
-            "{} | {} = {:.6e} (ref {:.6e}, tol {:.1e}) {}",
-            c.case, c.quantity, c.value, c.reference, c.tolerance, c.pass
-        );
-    }
-    for c in &report.checks {
-        assert!(
-            c.pass,
-            "{}: {} = {} vs {} ± {}",
-            c.case, c.quantity, c.value, c.reference, c.tolerance
-        );
-    }
-}
+use crate::common::assert_passes;
 
 #[test]
 #[ignore = "heavy tier (≈ 40 s on 2 cores): cargo test -- --ignored"]

@@ -3,7 +3,6 @@
 //! its mass accounted for to round-off, and writes its outputs; the Beverloo case runs at the
 //! test size.
 
-use granflow::report::Fidelity;
 use granflow::scenario::checkpointing::Control;
 use granflow::scenario::granular::run::run_granular;
 use granflow::scenario::granular::GranularScenario;
@@ -138,12 +137,5 @@ fn a_small_silo_discharges_with_its_mass_accounted_for() {
 #[test]
 #[ignore = "heavy tier (≈ 80 s on 2 cores): cargo test -- --ignored"]
 fn silo_beverloo_at_the_test_size() {
-    let report = granflow::scenario::validation::run("silo-beverloo", Fidelity::Test).unwrap();
-    for c in &report.checks {
-        println!(
-            "{} {} {:.4e} (ref {:.4e} ± {:.1e})",
-            c.case, c.quantity, c.value, c.reference, c.tolerance
-        );
-    }
-    assert!(report.checks.iter().all(|c| c.pass));
+    crate::common::assert_passes("silo-beverloo");
 }

@@ -13,7 +13,7 @@
 //!   the 5 % gate alone does not exclude over the bulk, gives 1).
 
 use super::profile::Profile;
-use super::run::release;
+use super::run::{kinetic, release};
 use super::spec::{GranularScenario, ProfileSpec};
 use crate::analysis::bagnold;
 use crate::report::{Check, Fidelity, Plot, Report, Series};
@@ -22,16 +22,6 @@ use crate::{Error, Result};
 
 const CASE: &str = "chute-bagnold";
 const SCENARIO: &str = include_str!("../../../models/dem/chute.toml");
-
-/// Kinetic energy, translational and rotational (J).
-fn kinetic(g: &crate::dem::Grains) -> f64 {
-    (0..g.len())
-        .map(|i| {
-            0.5 * (g.mass[i] * (g.vx[i] * g.vx[i] + g.vy[i] * g.vy[i])
-                + g.inertia[i] * g.omega[i] * g.omega[i])
-        })
-        .sum()
-}
 
 /// Run the case. Test fidelity: the chute half as long (16 bumps), 8 s, averaged over 4–8 s,
 /// the free exponent within ± 0.3; full: the model file as it is (32 bumps, 12 s, averaged

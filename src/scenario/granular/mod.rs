@@ -29,10 +29,15 @@ impl GranularScenario {
             Some(s) => format!("settle behind {gates} gate(s), at most {} s", s.max_time),
             None => "none: the grains start as listed".into(),
         };
+        let periodic = match self.periodic_x {
+            Some([a, b]) => format!("in x over [{a}, {b}] m"),
+            None => "no".into(),
+        };
         Ok(format!(
             "scenario        {} — {} (granular)\n\
              grains          {} ({:.4e} kg), from {} region(s) and {} listed\n\
              walls           {} ({} moving after the release), {} gate(s), {} outlet(s)\n\
+             periodic        {periodic}\n\
              gravity         [{}, {}] m/s²\n\
              settling        {settle}\n\
              dt              {:.4e} s (λ·Δt_cr, λ = {}, Δt_cr = {:.4e} s)\n\

@@ -131,7 +131,7 @@ fn advance(dem: &mut Dem, outlets: &[[[f64; 2]; 2]], steps: u64) -> Result<(u64,
 }
 
 /// Kinetic energy, translational and rotational (J).
-fn kinetic(g: &Grains) -> f64 {
+pub(super) fn kinetic(g: &Grains) -> f64 {
     (0..g.len())
         .map(|i| {
             0.5 * (g.mass[i] * (g.vx[i] * g.vx[i] + g.vy[i] * g.vy[i])

@@ -22,7 +22,7 @@ pub const BULK_MARGIN: f64 = 0.15;
 pub struct BagnoldFit {
     /// Flow depth h above the base.
     pub depth: f64,
-    /// Bulk solid fraction (median over the bulk slices).
+    /// Bulk solid fraction (median over the middle third of the occupied slices).
     pub bulk_fraction: f64,
     /// Slip speed u_s on the base.
     pub slip: f64,
@@ -45,8 +45,7 @@ pub struct BagnoldFit {
 /// (φ never falls below half its bulk value) or fewer than 5 slices lie in the bulk.
 pub fn fit(y: &[f64], phi: &[f64], u: &[f64], y_base: f64) -> Option<BagnoldFit> {
     let above: Vec<usize> = (0..y.len()).filter(|&k| y[k] > y_base).collect();
-    // Bulk solid fraction: the median over the slices between the first and the last third
-    // of the occupied slices, iterated once with the depth it gives.
+    // Bulk solid fraction: the median over the middle third of the occupied slices.
     let occupied: Vec<usize> = above.iter().copied().filter(|&k| phi[k] > 0.0).collect();
     let (&first, &last) = (occupied.first()?, occupied.last()?);
     let median = |ks: &[usize]| -> Option<f64> {

@@ -2,6 +2,7 @@
 //! skin and global damping.
 
 use super::contact::ContactParams;
+use super::grains::Grains;
 
 /// Parameters of a DEM system, SI.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -22,7 +23,10 @@ pub struct DemParams {
     pub global_damping: f64,
     /// Periodic in x over [x0, x1) (`None`: not periodic). A grain leaving through one end
     /// comes back through the other, and grains near the two ends touch through the period
-    /// (minimal image, [`min_image`]). Disks only; the walls are not repeated.
+    /// (minimal image, [`min_image`]). Disks only; the walls are not repeated. With g_x ≠ 0
+    /// the potential energy −Σ m **g**·**x** of [`super::Energy`] uses the wrapped positions,
+    /// so it jumps by m g_x L when a grain crosses an end: the energy budget of such a run does
+    /// not close.
     pub periodic_x: Option<[f64; 2]>,
 }
 
@@ -55,5 +59,32 @@ impl DemParams {
     /// Length of the x period, if periodic.
     pub fn period(&self) -> Option<f64> {
         self.periodic_x.map(|[a, b]| b - a)
+    }
+
+    /// Check the period for `grains` (`field` names it in the error): finite, at least
+    /// 3 (2 R_max + skin) long (the cell list's three neighbour columns then differ), and the
+    /// grains all disks (the polygon detector sees no images).
+    pub fn check_period(&self, grains: &Grains, field: &str) -> crate::Result<()> {
+        let Some([a, b]) = self.periodic_x else {
+            return Ok(());
+        };
+        let d_max = 2.0 * grains.max_radius();
+        let reach = 3.0 * d_max * (1.0 + self.skin_fraction);
+        if !(a.is_finite() && b.is_finite() && b - a >= reach) {
+            return Err(crate::Error::config(
+                field,
+                format!(
+                    "the period [{a}, {b}] must be finite and at least 3 (d_max + skin) = \
+                     {reach:.4e} m long"
+                ),
+            ));
+        }
+        if grains.has_polygons() {
+            return Err(crate::Error::config(
+                field,
+                "a periodic domain holds disks only (the polygon detector sees no images)",
+            ));
+        }
+        Ok(())
     }
 }

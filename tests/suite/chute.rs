@@ -153,14 +153,15 @@ fn chute() -> String {
 }
 
 /// The chute model derives: grains inside the period, the row of 32 bumps with its images
-/// across the ends; bad periodic input is refused naming the key.
+/// across the ends; bad periodic input (a period reversed, too short, or not holding the
+/// grains) is refused naming the key.
 #[test]
 fn the_chute_model_checks_and_bad_periodic_input_is_refused() {
     let s = GranularScenario::from_toml(&chute()).unwrap();
     let d = s.derive().unwrap();
     assert!(d.grains.len() > 500);
     assert_eq!(d.params.periodic_x, Some([0.0, 0.036]));
-    // 32 bumps, and the first two and the last two repeated one period beyond (within
+    // 32 bumps, and the first three and the last three repeated one period beyond (within
     // R_b + 2 d_max = 3.3 mm of an end: bump centres at 0.56, 1.69, 2.81 mm from it).
     assert_eq!(d.walls.len(), 32 + 3 + 3);
     let cases: &[(&str, &str, &str)] = &[
@@ -197,6 +198,13 @@ fn the_chute_model_checks_and_bad_periodic_input_is_refused() {
             .to_string();
         assert!(e.contains(field), "{to}: {e}");
     }
+    // A period too short for the cell list is refused by `check` already, not at the run.
+    let short = chute().replacen("periodic_x = [0.0, 0.036]", "periodic_x = [0.0, 0.004]", 1);
+    let e = GranularScenario::from_toml(&short)
+        .and_then(|s| s.derive().map(|_| ()))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("periodic_x") && e.contains("at least 3"), "{e}");
 }
 
 /// `chute-bagnold` at the test size (a chute 16 bumps long, 8 s, averaged over 4–8 s).

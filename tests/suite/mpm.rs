@@ -482,17 +482,14 @@ fn a_tilted_gravity_slides_the_column_down_the_plane() {
         "{momentum} against {expected}"
     );
     let text = std::fs::read_to_string(model("0.5")).unwrap();
-    for (g, kind) in [("[0.0, 9.81]", "mpm"), ("[9.81, 0.0]", "mpm")] {
+    for g in ["[0.0, 9.81]", "[9.81, 0.0]"] {
         let e = MpmScenario::from_toml(
             &text.replace("gravity = [0.0, -9.81]", &format!("gravity = {g}")),
         )
         .and_then(|s| s.build().map(|_| ()))
         .unwrap_err()
         .to_string();
-        assert!(
-            e.contains("gravity") && e.contains("g_y < 0"),
-            "{kind} {g}: {e}"
-        );
+        assert!(e.contains("gravity") && e.contains("g_y < 0"), "{g}: {e}");
     }
 }
 

@@ -259,24 +259,7 @@ impl Dem {
             dt,
         } = TimeStep::of_grains(&params, &grains).map_err(|e| e.within("dem"))?;
         let skin = params.skin_fraction * 2.0 * grains.max_radius().max(f64::MIN_POSITIVE);
-        if let Some([a, b]) = params.periodic_x {
-            let reach = 3.0 * (2.0 * grains.max_radius() + skin);
-            if !(a.is_finite() && b.is_finite() && b - a >= reach) {
-                return Err(Error::config(
-                    "dem.periodic_x",
-                    format!(
-                        "the period [{a}, {b}] must be finite and at least 3 (2 R_max + skin) \
-                         = {reach:.4e} m long"
-                    ),
-                ));
-            }
-            if grains.has_polygons() {
-                return Err(Error::config(
-                    "dem.periodic_x",
-                    "a periodic domain holds disks only (the polygon detector sees no images)",
-                ));
-            }
-        }
+        params.check_period(&grains, "dem.periodic_x")?;
         let shapes = RapierDetector::needed(&grains, &walls).then(|| ShapeContacts::new(skin));
         Ok(Dem {
             shapes,

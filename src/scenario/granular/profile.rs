@@ -90,11 +90,6 @@ impl Profile {
         self.samples += 1;
     }
 
-    /// Samples taken.
-    pub fn samples(&self) -> u64 {
-        self.samples
-    }
-
     /// The averaged slices, bottom to top.
     pub fn slices(&self) -> Vec<Slice> {
         let [lo, hi] = self.spec.rectangle;

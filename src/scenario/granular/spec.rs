@@ -294,30 +294,6 @@ impl GranularScenario {
             grains.vy[i] = s.velocity[1];
             grains.omega[i] = s.angular_velocity;
         }
-        let period = self.periodic_x.map(|[a, b]| b - a);
-        if let Some([a, b]) = self.periodic_x {
-            finite("periodic_x", &[a, b])?;
-            if b <= a {
-                return Err(Error::config(
-                    "periodic_x",
-                    format!("must be [x0, x1] with x1 > x0, got [{a}, {b}]"),
-                ));
-            }
-            if let Some(k) = (0..grains.len()).find(|&k| {
-                grains.x[k] - grains.radius[k] < a - 1e-12 * (b - a)
-                    || grains.x[k] + grains.radius[k] > b + 1e-12 * (b - a)
-            }) {
-                return Err(Error::config(
-                    "periodic_x",
-                    format!(
-                        "grain {k} at x = {:.6e} m is not inside the period [{a}, {b}] (the \
-                         [[fill]] regions and [[grain]] entries must lie within it)",
-                        grains.x[k]
-                    ),
-                ));
-            }
-        }
-        check_listed_apart(&grains, first_listed, period)?;
         if grains.is_empty() {
             return Err(Error::config(
                 "fill",
@@ -381,6 +357,25 @@ impl GranularScenario {
         let mut params = DemParams::new(grain, wall, self.gravity);
         params.lambda = t.lambda;
         params.periodic_x = self.periodic_x;
+        params.check_period(&grains, "periodic_x")?;
+        if let Some([a, b]) = self.periodic_x {
+            let slack = 1e-12 * (b - a);
+            let outside = |k: usize| {
+                grains.x[k] - grains.radius[k] < a - slack
+                    || grains.x[k] + grains.radius[k] > b + slack
+            };
+            if let Some(k) = (0..grains.len()).find(|&k| outside(k)) {
+                return Err(Error::config(
+                    "periodic_x",
+                    format!(
+                        "grain {k} at x = {:.6e} m is not inside the period [{a}, {b}] (the \
+                         [[fill]] regions and [[grain]] entries must lie within it)",
+                        grains.x[k]
+                    ),
+                ));
+            }
+        }
+        check_listed_apart(&grains, first_listed, params.period())?;
         let time_step = TimeStep::of_grains(&params, &grains).map_err(|e| e.within("time"))?;
         Ok(DerivedGranular {
             params,
@@ -478,29 +473,8 @@ impl GranularScenario {
         let (mut walls, mut gates) = (Vec::new(), Vec::new());
         for (k, w) in self.wall.iter().enumerate() {
             let field = format!("wall[{k}]");
-            if let Some(b) = &w.bumps {
-                if w.segment.is_some() || w.polygon.is_some() || w.plane.is_some() {
-                    return Err(Error::config(
-                        field,
-                        "give exactly one of `segment`, `polygon`, `plane` and `bumps`",
-                    ));
-                }
-                if w.velocity.is_some() {
-                    return Err(Error::config(
-                        format!("{field}.velocity"),
-                        "only segments and planes that stay after the release can move",
-                    ));
-                }
-                let row = self.bumps(&format!("{field}.bumps"), b)?;
-                if w.gate {
-                    gates.extend(row);
-                } else {
-                    walls.extend(row.into_iter().map(|d| (d, None)));
-                }
-                continue;
-            }
-            let wall = match (&w.segment, &w.polygon, &w.plane) {
-                (&Some([a, b]), None, None) => {
+            let row = match (&w.segment, &w.polygon, &w.plane, &w.bumps) {
+                (&Some([a, b]), None, None, None) => {
                     finite(&format!("{field}.segment"), &[a[0], a[1], b[0], b[1]])?;
                     if a == b {
                         return Err(Error::config(
@@ -508,24 +482,25 @@ impl GranularScenario {
                             "its two ends are the same point",
                         ));
                     }
-                    Wall::Segment { a, b }
+                    vec![Wall::Segment { a, b }]
                 }
-                (None, Some(p), None) => {
+                (None, Some(p), None, None) => {
                     finite(&format!("{field}.polygon"), p.as_flattened())?;
-                    Wall::polygon(p, &format!("{field}.polygon"))?
+                    vec![Wall::polygon(p, &format!("{field}.polygon"))?]
                 }
-                (None, None, Some(pl)) => {
+                (None, None, Some(pl), None) => {
                     let f = format!("{field}.plane");
                     finite(&f, &[pl.point[0], pl.point[1], pl.normal[0], pl.normal[1]])?;
                     let len = pl.normal[0].hypot(pl.normal[1]);
                     if len == 0.0 {
                         return Err(Error::config(f + ".normal", "must not be zero"));
                     }
-                    Wall::Plane {
+                    vec![Wall::Plane {
                         point: pl.point,
                         normal: [pl.normal[0] / len, pl.normal[1] / len],
-                    }
+                    }]
                 }
+                (None, None, None, Some(b)) => self.bumps(&format!("{field}.bumps"), b)?,
                 _ => {
                     return Err(Error::config(
                         field,
@@ -535,7 +510,7 @@ impl GranularScenario {
             };
             if let Some(v) = w.velocity {
                 finite(&format!("{field}.velocity"), &v)?;
-                if w.gate || w.polygon.is_some() {
+                if w.gate || w.polygon.is_some() || w.bumps.is_some() {
                     return Err(Error::config(
                         format!("{field}.velocity"),
                         "only segments and planes that stay after the release can move",
@@ -543,9 +518,9 @@ impl GranularScenario {
                 }
             }
             if w.gate {
-                gates.push(wall);
+                gates.extend(row);
             } else {
-                walls.push((wall, w.velocity));
+                walls.extend(row.into_iter().map(|wall| (wall, w.velocity)));
             }
         }
         if walls.iter().any(|(w, _)| !w.is_straight()) && walls.iter().any(|(_, v)| v.is_some()) {

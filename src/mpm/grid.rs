@@ -1,8 +1,15 @@
 //! The uniform background grid: `nx` × `ny` cells of size h, (nx + 1)(ny + 1) nodes, stored
 //! x-major (node (i, j) at i·(ny + 1) + j) so a band of node columns is one contiguous slice
 //! (what the race-free parallel particle-to-grid transfer splits on).
+//!
+//! Periodic in x ([`Grid::with_period_x`]): the node columns [c₀, c₀ + n) are the period, and
+//! every other column i is an image of column c₀ + (i − c₀) mod n. After each scatter the
+//! images' sums are added into their column and copied back ([`Grid::fold`]), so a point near
+//! one end of the period scatters into the nodes beyond it exactly as into the nodes at the
+//! other end, and every image holds the same mass, momentum, force and hence velocity.
 
-use super::boundary::Wall;
+use super::boundary::{Side, Wall};
+use crate::{Error, Result};
 
 /// Per-node accumulators of the particle-to-grid transfer: mass, momentum (x, y), force (x, y).
 pub type NodeSums = [f64; 5];
@@ -33,6 +40,8 @@ pub struct Grid {
     pub contact: Vec<u8>,
     /// The walls.
     pub walls: Vec<Wall>,
+    /// Periodic in x: (first node column of the period c₀, columns in the period n).
+    pub period_x: Option<(usize, usize)>,
 }
 
 impl Grid {
@@ -62,6 +71,80 @@ impl Grid {
             walls_mask,
             contact: vec![0u8; n],
             walls,
+            period_x: None,
+        }
+    }
+
+    /// The same grid periodic in x over the node columns [first, first + cells) (x from
+    /// origin + first·h to origin + (first + cells)·h). Refuses walls on the left or right and
+    /// a period that leaves fewer than two columns of images beyond either end (a uGIMP stencil
+    /// reaches h + l_p ≤ 1.5 h past a point).
+    pub fn with_period_x(mut self, first: usize, cells: usize) -> Result<Self> {
+        if cells == 0 || first < 2 || first + cells + 2 > self.nx {
+            return Err(Error::Other(format!(
+                "a period of {cells} cells from node column {first} needs two columns of images \
+                 on each side of it in a grid of {} cells",
+                self.nx
+            )));
+        }
+        if self
+            .walls
+            .iter()
+            .any(|w| matches!(w.side, Side::Left | Side::Right))
+        {
+            return Err(Error::Other(
+                "a grid periodic in x has no left or right walls".into(),
+            ));
+        }
+        self.period_x = Some((first, cells));
+        Ok(self)
+    }
+
+    /// The x interval of the period (m), if periodic.
+    pub fn period_bounds(&self) -> Option<[f64; 2]> {
+        self.period_x.map(|(c0, n)| {
+            let x0 = self.origin[0] + c0 as f64 * self.h;
+            [x0, x0 + n as f64 * self.h]
+        })
+    }
+
+    /// Whether node `n` is one of the period's own nodes (always, without a period): sums over
+    /// the grid (mass, momentum, wall work) count these only.
+    #[inline(always)]
+    pub fn owns(&self, n: usize) -> bool {
+        match self.period_x {
+            None => true,
+            Some((c0, cells)) => (c0..c0 + cells).contains(&(n / self.nny())),
+        }
+    }
+
+    /// Periodic in x: add each image column's sums (components `which`) into its column of
+    /// the period, then copy them back to the images. Nothing without a period.
+    pub fn fold(&mut self, which: [bool; 5]) {
+        let Some((c0, cells)) = self.period_x else {
+            return;
+        };
+        let nny = self.nny();
+        let image = |i: usize| c0 + (i + cells - c0 % cells) % cells;
+        let ghosts = (0..c0).chain(c0 + cells..=self.nx);
+        for i in ghosts.clone() {
+            let c = image(i);
+            for j in 0..nny {
+                let (from, to) = (self.sums[i * nny + j], &mut self.sums[c * nny + j]);
+                for k in (0..5).filter(|&k| which[k]) {
+                    to[k] += from[k];
+                }
+            }
+        }
+        for i in ghosts {
+            let c = image(i);
+            for j in 0..nny {
+                let to = self.sums[c * nny + j];
+                let from = &mut self.sums[i * nny + j];
+                for k in (0..5).filter(|&k| which[k]) {
+                    from[k] = to[k];
+                }
+            }
         }
     }
 

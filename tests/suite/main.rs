@@ -25,6 +25,7 @@ mod granular;
 mod io_vtk;
 mod models;
 mod mpm;
+mod mpm_periodic;
 mod multiscale;
 mod paraview;
 mod resume;

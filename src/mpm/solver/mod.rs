@@ -467,6 +467,11 @@ impl<M: Material> Mpm<M> {
     /// Add pressure loads on boundary faces of points. Refuses a point index out of range, a
     /// normal that is not ±x or ±y, a pressure that is not finite, or a face outside the grid.
     pub fn add_tractions(&mut self, loads: impl IntoIterator<Item = Traction>) -> Result<()> {
+        if self.grid.period_x.is_some() {
+            return Err(Error::Other(
+                "traction loads on a grid periodic in x are not supported".into(),
+            ));
+        }
         for t in loads {
             if t.point as usize >= self.points.len() {
                 return Err(Error::Other(format!(
@@ -680,11 +685,13 @@ impl<M: Material> Mpm<M> {
         (m, mv)
     }
 
-    /// Total nodal mass and momentum after the last P2G (momentum as last mapped).
+    /// Total nodal mass and momentum after the last P2G (momentum as last mapped; a periodic
+    /// grid's images not counted).
     pub fn grid_mass_momentum(&self) -> (f64, [f64; 2]) {
         let mut m = 0.0;
         let mut mv = [0.0; 2];
-        for s in &self.grid.sums {
+        let g = &self.grid;
+        for s in (0..g.nodes()).filter(|&n| g.owns(n)).map(|n| &g.sums[n]) {
             m += s[0];
             mv[0] += s[1];
             mv[1] += s[2];

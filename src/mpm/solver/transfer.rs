@@ -50,9 +50,32 @@ impl<M: Material> Mpm<M> {
         self.perm = perm;
     }
 
+    /// Periodic in x: move every point outside the period by whole periods into it (its
+    /// reference position `pos0` with it, so displacements stay continuous).
+    fn wrap(&mut self) {
+        let Some([x0, x1]) = self.grid.period_bounds() else {
+            return;
+        };
+        let l = x1 - x0;
+        let p = &mut self.points;
+        for (x, x_ref) in p.pos.iter_mut().zip(p.pos0.iter_mut()) {
+            if x[0] < x0 || x[0] >= x1 {
+                let shift = l * ((x[0] - x0) / l).floor();
+                x[0] -= shift;
+                x_ref[0] -= shift;
+                if x[0] >= x1 {
+                    // Round-off of a point a hair below x0.
+                    x[0] -= l;
+                    x_ref[0] -= l;
+                }
+            }
+        }
+    }
+
     /// Bin the points into stripes by the node column where their stencil starts; checks that
     /// every point is finite and its stencil inside the grid.
     pub(super) fn bin(&mut self) -> Result<()> {
+        self.wrap();
         let g = &self.grid;
         let shape = self.params.shape;
         let ns = self.stripe_start.len() - 1;
@@ -176,6 +199,8 @@ impl<M: Material> Mpm<M> {
                     }
                 });
         }
+        let moved = mass || momentum;
+        g.fold([mass, moved, moved, force, force]);
     }
 
     /// Grid velocities from momenta: `vel` = p/m (unconstrained; the FLIP reference) and, when
@@ -214,6 +239,9 @@ impl<M: Material> Mpm<M> {
         let g = &mut self.grid;
         let (eps, dt, alpha) = (self.mass_eps, self.dt, self.params.damping);
         let walls = &g.walls;
+        let (period, nny) = (g.period_x, g.nny());
+        let owns =
+            |n: usize| period.is_none_or(|(c0, cells)| (c0..c0 + cells).contains(&(n / nny)));
         let node = |vn: &mut [f64; 2], v: &[f64; 2], s: &[f64; 5], mask, engaged: &mut u8| {
             if s[0] <= eps {
                 *vn = [0.0; 2];
@@ -247,10 +275,17 @@ impl<M: Material> Mpm<M> {
             .zip(g.sums.par_chunks(CHUNK))
             .zip(g.walls_mask.par_chunks(CHUNK))
             .zip(g.contact.par_chunks_mut(CHUNK))
-            .map(|((((vn, v), s), mask), engaged)| {
-                crate::exec::add_in_order(
-                    (0..vn.len()).map(|k| node(&mut vn[k], &v[k], &s[k], mask[k], &mut engaged[k])),
-                )
+            .enumerate()
+            .map(|(c, ((((vn, v), s), mask), engaged))| {
+                crate::exec::add_in_order((0..vn.len()).map(|k| {
+                    let e = node(&mut vn[k], &v[k], &s[k], mask[k], &mut engaged[k]);
+                    // An image node of a periodic grid does the work of its own node again.
+                    if owns(c * CHUNK + k) {
+                        e
+                    } else {
+                        [0.0; 3]
+                    }
+                }))
             })
             .collect();
         let e = crate::exec::add_in_order(parts);

@@ -202,6 +202,8 @@ enum SchemaKind {
     Submerged,
     /// A DEM problem of any geometry (regions, walls, gates, outlets).
     Granular,
+    /// An MPM problem of any geometry (domain, sides, regions, tilting gravity).
+    Continuum,
     /// A study over many collapse scenarios.
     Sweep,
     /// Every kind (with --markdown only).
@@ -218,6 +220,7 @@ impl SchemaKind {
             SchemaKind::Mpm => Some(Kind::Mpm),
             SchemaKind::Submerged => Some(Kind::Submerged),
             SchemaKind::Granular => Some(Kind::Granular),
+            SchemaKind::Continuum => Some(Kind::Continuum),
             SchemaKind::Sweep => Some(Kind::Sweep),
             SchemaKind::All => None,
         }

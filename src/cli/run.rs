@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 
 use granflow::scenario::checkpointing::{Control, SCENARIO_COPY};
+use granflow::scenario::continuum::ContinuumScenario;
 use granflow::scenario::dem::spec::dem_memory;
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::fluid::Scenario;
@@ -33,6 +34,11 @@ pub fn check(path: &Path, sets: &[Override]) -> Result<ExitCode> {
         }
         Kind::Granular => {
             let s = GranularScenario::from_text(&text, path)?;
+            print!("{}", s.check_report()?);
+            Ok(ExitCode::SUCCESS)
+        }
+        Kind::Continuum => {
+            let s = ContinuumScenario::from_text(&text, path)?;
             print!("{}", s.check_report()?);
             Ok(ExitCode::SUCCESS)
         }
@@ -358,6 +364,25 @@ fn run_resumable<'a>(
             );
             let r = with_progress((1e3 * s.time.end) as u64, "ms", |p| {
                 granflow::scenario::granular::run::run_granular(&s, dir, control, p)
+            })
+            .with_context(|| stopped(path, dir))?;
+            println!("{}", r.done_line());
+            Ok(ExitCode::SUCCESS)
+        }
+        Kind::Continuum => {
+            let s = ContinuumScenario::from_text(text, path)?;
+            let d = s.derive()?;
+            let dir = take(ContinuumScenario::memory_bytes(&d))?;
+            eprintln!(
+                "{}: continuum, {} points, {} × {} cells -> {}",
+                s.name,
+                d.points.len(),
+                d.cells[0],
+                d.cells[1],
+                dir.display()
+            );
+            let r = with_progress((1e3 * s.time.end) as u64, "ms", |p| {
+                granflow::scenario::continuum::run::run_continuum(&s, dir, control, p)
             })
             .with_context(|| stopped(path, dir))?;
             println!("{}", r.done_line());

@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use anyhow::Result;
 use serde_json::Value;
 
+use granflow::scenario::continuum::ContinuumScenario;
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::fluid::Scenario;
 use granflow::scenario::granular::GranularScenario;
@@ -23,6 +24,7 @@ fn of(kind: Kind) -> Value {
         Kind::Mpm => schema::of::<MpmScenario>(),
         Kind::Submerged => schema::of::<SubmergedScenario>(),
         Kind::Granular => schema::of::<GranularScenario>(),
+        Kind::Continuum => schema::of::<ContinuumScenario>(),
         Kind::Sweep => schema::of::<SweepSpec>(),
     }
 }

@@ -27,7 +27,7 @@ use crate::{Error, Result};
 /// The first bytes of every checkpoint.
 const MAGIC: &[u8; 20] = b"granflow checkpoint\n";
 /// Version of the layout above and of the states' encoding; a file of another is refused.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 /// Bytes before the body.
 const PREAMBLE: usize = MAGIC.len() + 4 + 8 + 4;
 /// Checkpoints a folder keeps (the newest ones).

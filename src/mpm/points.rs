@@ -82,13 +82,28 @@ impl<S: Default> Points<S> {
     /// rectangle's sides should be multiples of h/n), each of volume (h/n)² and half-width
     /// l_p = h/(2n).
     pub fn fill_rect(&mut self, lo: [f64; 2], hi: [f64; 2], h: f64, n: usize, density: f64) {
+        self.fill_where(lo, hi, h, n, density, |_| true);
+    }
+
+    /// As [`Points::fill_rect`], keeping only the points whose position `inside` accepts.
+    pub fn fill_where(
+        &mut self,
+        lo: [f64; 2],
+        hi: [f64; 2],
+        h: f64,
+        n: usize,
+        density: f64,
+        inside: impl Fn([f64; 2]) -> bool,
+    ) {
         let d = h / n as f64;
         let nx = ((hi[0] - lo[0]) / d).round() as usize;
         let ny = ((hi[1] - lo[1]) / d).round() as usize;
         for i in 0..nx {
             for j in 0..ny {
                 let p = [lo[0] + (i as f64 + 0.5) * d, lo[1] + (j as f64 + 0.5) * d];
-                self.push(p, d * d, density, 0.5 * d);
+                if inside(p) {
+                    self.push(p, d * d, density, 0.5 * d);
+                }
             }
         }
     }

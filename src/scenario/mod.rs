@@ -1,6 +1,7 @@
 //! The scenario storey: what a user writes and runs. Scenario files are TOML in SI units,
 //! `deny_unknown_fields`, with no silent defaults for physical parameters; each says what it
-//! is on its first line, `kind = "fluid" | "dem" | "mpm" | "submerged" | "granular" | "sweep"`
+//! is on its first line, `kind = "fluid" | "dem" | "mpm" | "submerged" | "granular" |
+//! "continuum" | "sweep"`
 //! ([`Kind`]), so a typo gets the error of the kind it is.
 //!
 //! Per kind, a folder holds the file's schema (`spec.rs`: parse, check every value, derive
@@ -14,6 +15,8 @@
 //! * [`submerged`]: the LBM–DEM submerged collapse;
 //! * [`granular`]: DEM problems of any geometry (silo, hopper, chute, obstacles): regions,
 //!   walls, gates and outlets as data;
+//! * [`continuum`]: MPM problems of any geometry (slopes, layers, blocks): domain, sides,
+//!   regions, gravity and its tilt as data;
 //! * [`collapse`]: the one column-collapse runner, for the DEM, MPM and submerged solids;
 //! * [`validation`]: the registry of validation cases (`granflow validate`);
 //! * [`checkpointing`]: checkpoints, resume and the stop signals ask for;
@@ -26,6 +29,7 @@
 
 pub mod checkpointing;
 pub mod collapse;
+pub mod continuum;
 pub mod dem;
 pub mod field;
 pub mod fluid;
@@ -58,18 +62,22 @@ pub enum Kind {
     /// A DEM problem of any geometry: regions, walls, gates, outlets
     /// ([`granular::GranularScenario`]).
     Granular,
+    /// An MPM problem of any geometry: domain, sides, regions, tilting gravity
+    /// ([`continuum::ContinuumScenario`]).
+    Continuum,
     /// A study over many collapse scenarios ([`crate::sweep::SweepSpec`]).
     Sweep,
 }
 
 impl Kind {
     /// Every kind, in the order the documentation lists them.
-    pub const ALL: [Kind; 6] = [
+    pub const ALL: [Kind; 7] = [
         Kind::Fluid,
         Kind::Dem,
         Kind::Mpm,
         Kind::Submerged,
         Kind::Granular,
+        Kind::Continuum,
         Kind::Sweep,
     ];
 
@@ -81,6 +89,7 @@ impl Kind {
             Kind::Mpm => "mpm",
             Kind::Submerged => "submerged",
             Kind::Granular => "granular",
+            Kind::Continuum => "continuum",
             Kind::Sweep => "sweep",
         }
     }
@@ -92,6 +101,8 @@ impl Kind {
             Kind::Sweep
         } else if table.contains_key("coupling") {
             Kind::Submerged
+        } else if table.contains_key("domain") {
+            Kind::Continuum
         } else if table.contains_key("wall") || table.contains_key("fill") {
             Kind::Granular
         } else if table.contains_key("grains") {

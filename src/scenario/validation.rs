@@ -105,6 +105,11 @@ pub const CASES: &[Case] = &[
         run: super::granular::chute::run,
     },
     Case {
+        name: "mpm-slope",
+        description: "infinite slope on a tilting table: sliding at tan φ/tan β = 1 (ψ = φ) and tan β = sin φ (ψ = 0) within 1°",
+        run: super::continuum::slope::run,
+    },
+    Case {
         name: "rve-biaxial",
         description: "periodic volume vs wall-bounded biaxial test of one material: φ peak and critical within 2°",
         run: |f| checks_only(super::dem::rve_biaxial::validation(f)),

@@ -20,6 +20,7 @@ use std::sync::OnceLock;
 use proptest::prelude::*;
 use toml::Value;
 
+use granflow::scenario::continuum::ContinuumScenario;
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::fluid::Scenario;
 use granflow::scenario::granular::GranularScenario;
@@ -76,6 +77,9 @@ fn check(text: &str) -> granflow::Result<()> {
             .check_report()
             .map(|_| ()),
         Kind::Granular => GranularScenario::from_toml(text)?
+            .check_report()
+            .map(|_| ()),
+        Kind::Continuum => ContinuumScenario::from_toml(text)?
             .check_report()
             .map(|_| ()),
         Kind::Sweep => {

@@ -13,6 +13,7 @@ mod chute;
 mod cli;
 mod collapse_study;
 mod conservation_properties;
+mod continuum;
 mod coupling;
 mod coupling_ladd;
 mod dem;

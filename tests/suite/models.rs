@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use granflow::scenario::continuum::ContinuumScenario;
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::fluid::Scenario;
 use granflow::scenario::granular::GranularScenario;
@@ -60,6 +61,9 @@ fn every_model_file_declares_its_kind_and_checks_as_it() {
                 .map(|_| ()),
             Kind::Granular => GranularScenario::from_file(f)
                 .and_then(|s| s.derive())
+                .map(|_| ()),
+            Kind::Continuum => ContinuumScenario::from_file(f)
+                .and_then(|s| s.check_report())
                 .map(|_| ()),
             // Every case of a sweep (its base with the sweep's keys set) checks as its kind.
             Kind::Sweep => granflow::sweep::read_sweep(f)

@@ -57,9 +57,12 @@ fn sliding_block(x0: f64) -> Mpm {
     mpm
 }
 
+/// A point's reference position, displacement, velocity and stress.
+type PointRow = ([f64; 2], [f64; 2], [f64; 2], [f64; 4]);
+
 /// Points sorted by their reference position (x taken modulo the period, less `shift`), with
 /// their displacement from it, velocity and stress.
-fn by_reference(mpm: &Mpm, shift: f64) -> Vec<([f64; 2], [f64; 2], [f64; 2], [f64; 4])> {
+fn by_reference(mpm: &Mpm, shift: f64) -> Vec<PointRow> {
     let l = PERIOD as f64 * H;
     let p = &mpm.points;
     let mut v: Vec<_> = (0..p.len())

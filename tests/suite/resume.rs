@@ -12,6 +12,8 @@ use granflow::scenario::checkpointing::Control;
 use granflow::scenario::collapse::dem::run_resumable_collapse;
 use granflow::scenario::collapse::mpm::run_column_collapse_with;
 use granflow::scenario::collapse::submerged::run_submerged;
+use granflow::scenario::continuum::run::run_continuum;
+use granflow::scenario::continuum::ContinuumScenario;
 use granflow::scenario::dem::DemScenario;
 use granflow::scenario::granular::run::run_granular;
 use granflow::scenario::granular::GranularScenario;
@@ -327,6 +329,20 @@ fn a_silo_discharge_stopped_or_killed_part_way_resumes_to_the_uninterrupted_resu
     let s = GranularScenario::from_toml(&text).unwrap();
     stopped_and_killed_runs_resume_to_the_uninterrupted_result(&text, 0.02, |c, dir, p| {
         run_granular(&s, dir, c, p).map(|_| ())
+    });
+}
+
+#[test]
+fn a_tilting_slope_stopped_or_killed_part_way_resumes_to_the_uninterrupted_result() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/mpm/slope.toml");
+    let text = std::fs::read_to_string(model)
+        .unwrap()
+        .replace("cell_size = 0.05", "cell_size = 0.1")
+        .replace("end = 31.5", "end = 1.0")
+        .replace("frame_interval = 1.0", "frame_interval = 0.2");
+    let s = ContinuumScenario::from_toml(&text).unwrap();
+    stopped_and_killed_runs_resume_to_the_uninterrupted_result(&text, 0.2, |c, dir, p| {
+        run_continuum(&s, dir, c, p).map(|_| ())
     });
 }
 

@@ -12,7 +12,15 @@ use serde_json::Value;
 /// The command that writes docs/scenario-keys.md.
 const REGENERATE: &str = "cargo run --release -- schema all --markdown > docs/scenario-keys.md";
 
-const KINDS: [&str; 6] = ["fluid", "dem", "mpm", "submerged", "granular", "sweep"];
+const KINDS: [&str; 7] = [
+    "fluid",
+    "dem",
+    "mpm",
+    "submerged",
+    "granular",
+    "continuum",
+    "sweep",
+];
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))

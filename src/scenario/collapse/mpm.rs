@@ -226,7 +226,7 @@ pub fn shape<M: Material>(mpm: &Mpm<M>) -> Shape {
     }
 }
 
-fn write_frame<M: PointOutput>(
+pub(crate) fn write_frame<M: PointOutput>(
     mpm: &Mpm<M>,
     volumes: &[[f64; 2]],
     format: &VtkFormat,

@@ -405,28 +405,7 @@ impl GranularScenario {
                 format!("must be ≥ grains.d_max = {d_max} m, got {}", f.spacing),
             ));
         }
-        let vertices = match (&f.rectangle, &f.polygon) {
-            (Some(r), None) => {
-                let [a, b] = rectangle(&format!("{field}.rectangle"), *r)?;
-                vec![a, [b[0], a[1]], b, [a[0], b[1]]]
-            }
-            (None, Some(p)) => {
-                finite(&format!("{field}.polygon"), p.as_flattened())?;
-                if p.len() < 3 || polygon_area(p).abs() == 0.0 {
-                    return Err(Error::config(
-                        format!("{field}.polygon"),
-                        "needs at least 3 vertices enclosing an area",
-                    ));
-                }
-                p.clone()
-            }
-            _ => {
-                return Err(Error::config(
-                    field,
-                    "give exactly one of `rectangle` and `polygon`",
-                ))
-            }
-        };
+        let vertices = region_vertices(field, f.rectangle, f.polygon.as_deref())?;
         let (lo, hi) = bounds(&vertices);
         let region = Shape::Polygon {
             vertices: vertices.clone(),
@@ -597,6 +576,36 @@ fn check_listed_apart(g: &Grains, first: usize, period: Option<f64>) -> Result<(
 }
 
 /// Signed area of a polygon (positive counter-clockwise).
+/// The vertices of a region given as exactly one of a `rectangle` (corners, refused unless
+/// lower-left then upper-right) and a `polygon` (at least 3 finite vertices enclosing an
+/// area); refusals name `field`.
+pub(crate) fn region_vertices(
+    field: &str,
+    rectangle_corners: Option<[[f64; 2]; 2]>,
+    polygon: Option<&[[f64; 2]]>,
+) -> Result<Vec<[f64; 2]>> {
+    match (rectangle_corners, polygon) {
+        (Some(r), None) => {
+            let [a, b] = rectangle(&format!("{field}.rectangle"), r)?;
+            Ok(vec![a, [b[0], a[1]], b, [a[0], b[1]]])
+        }
+        (None, Some(p)) => {
+            finite(&format!("{field}.polygon"), p.as_flattened())?;
+            if p.len() < 3 || polygon_area(p).abs() == 0.0 {
+                return Err(Error::config(
+                    format!("{field}.polygon"),
+                    "needs at least 3 vertices enclosing an area",
+                ));
+            }
+            Ok(p.to_vec())
+        }
+        _ => Err(Error::config(
+            field,
+            "give exactly one of `rectangle` and `polygon`",
+        )),
+    }
+}
+
 fn polygon_area(v: &[[f64; 2]]) -> f64 {
     let n = v.len();
     0.5 * (0..n)
@@ -608,7 +617,7 @@ fn polygon_area(v: &[[f64; 2]]) -> f64 {
 }
 
 /// Lower-left and upper-right corners of the bounding box.
-fn bounds(v: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
+pub(crate) fn bounds(v: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
     v.iter().fold(
         ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
         |(lo, hi), p| {

@@ -11,6 +11,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::mpm::material::Stress;
+use crate::mpm::{Material, Mpm};
 use crate::scenario::field::{FieldValue, Scalar};
 use crate::{Error, Result};
 
@@ -108,4 +109,26 @@ impl MpmInitial {
     pub fn velocity(&self, x: [f64; 2]) -> Option<[f64; 2]> {
         self.velocity.as_ref().map(|p| at(p, x))
     }
+}
+
+/// Start the points of `mpm` at the stress and velocity `[initial]` gives (`spec`), the stress
+/// it does not give from `fallback`, at rest where it gives no velocity; a value that is not
+/// finite at a point is refused naming its key.
+pub fn start<M: Material>(
+    mpm: &mut Mpm<M>,
+    spec: Option<&MpmInitialSpec>,
+    fallback: impl Fn([f64; 2]) -> Stress + Sync,
+) -> Result<()> {
+    let Some(given) = spec.map(MpmInitialSpec::compile).transpose()? else {
+        return mpm.set_stress(fallback);
+    };
+    given.check(&mpm.points.pos)?;
+    mpm.set_stress(|x| given.stress(x).unwrap_or_else(|| fallback(x)))?;
+    let p = &mut mpm.points;
+    for (v, &x) in p.vel.iter_mut().zip(&p.pos) {
+        if let Some(u) = given.velocity(x) {
+            *v = u;
+        }
+    }
+    Ok(())
 }

@@ -28,7 +28,7 @@ use crate::mpm::shape::ShapeKind;
 use crate::mpm::solver::{Mpm, MpmParams, Scheme, Transfer};
 use crate::scenario::collapse::collapse_gravity;
 use crate::scenario::dem::spec::{ContactSpec, GrainsSpec};
-use crate::scenario::mpm::initial::MpmInitialSpec;
+use crate::scenario::mpm::initial::{start, MpmInitialSpec};
 use crate::scenario::{non_negative, positive, Kind, ScenarioFile};
 use crate::{Error, Result};
 
@@ -217,6 +217,49 @@ pub struct MpmSpec {
     pub resort_every: u64,
 }
 
+impl MpmSpec {
+    /// Check every value (fields named under `mpm.`).
+    pub fn check(&self) -> Result<()> {
+        positive("mpm.cell_size", self.cell_size)?;
+        if !(1..=8).contains(&self.points_per_cell) {
+            return Err(Error::config(
+                "mpm.points_per_cell",
+                format!(
+                    "must be 1..=8 (points per cell per direction), got {}",
+                    self.points_per_cell
+                ),
+            ));
+        }
+        if !(self.courant > 0.0 && self.courant <= 1.0) {
+            return Err(Error::config(
+                "mpm.courant",
+                format!("must be in (0, 1], got {}", self.courant),
+            ));
+        }
+        if !(self.damping >= 0.0 && self.damping < 1.0) {
+            return Err(Error::config(
+                "mpm.damping",
+                format!("must be in [0, 1), got {}", self.damping),
+            ));
+        }
+        self.transfer.check(self.shape, self.pic_fraction)
+    }
+
+    /// The solver parameters under `gravity`, with the step `dt` (else C h/c).
+    pub fn params(&self, gravity: [f64; 2], dt: Option<f64>) -> MpmParams {
+        MpmParams {
+            shape: self.shape,
+            scheme: self.scheme,
+            gravity,
+            courant: self.courant,
+            dt,
+            damping: self.damping,
+            pic_fraction: self.pic_fraction,
+            resort_every: self.resort_every,
+        }
+    }
+}
+
 /// Conditions of the three walls.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -267,7 +310,8 @@ pub struct DerivedMpm {
     pub wave_speed: f64,
 }
 
-fn check_wall(field: &str, w: &WallKind) -> Result<()> {
+/// Refuses a friction wall with μ < 0, naming `field.mu`.
+pub(crate) fn check_wall(field: &str, w: &WallKind) -> Result<()> {
     if let WallKind::Friction { mu } = w {
         non_negative(&format!("{field}.mu"), *mu)?;
     }
@@ -547,29 +591,7 @@ impl MpmScenario {
             ));
         }
         let m = &self.mpm;
-        positive("mpm.cell_size", m.cell_size)?;
-        if !(1..=8).contains(&m.points_per_cell) {
-            return Err(Error::config(
-                "mpm.points_per_cell",
-                format!(
-                    "must be 1..=8 (points per cell per direction), got {}",
-                    m.points_per_cell
-                ),
-            ));
-        }
-        if !(m.courant > 0.0 && m.courant <= 1.0) {
-            return Err(Error::config(
-                "mpm.courant",
-                format!("must be in (0, 1], got {}", m.courant),
-            ));
-        }
-        if !(m.damping >= 0.0 && m.damping < 1.0) {
-            return Err(Error::config(
-                "mpm.damping",
-                format!("must be in [0, 1), got {}", m.damping),
-            ));
-        }
-        m.transfer.check(m.shape, m.pic_fraction)?;
+        m.check()?;
         let height = c.aspect_ratio * c.width;
         let h = m.cell_size;
         let (Some(wc), Some(hc)) = (whole(c.width / h), whole(height / h)) else {
@@ -704,31 +726,10 @@ impl MpmScenario {
             self.mpm.points_per_cell,
             material.density(),
         );
-        let params = MpmParams {
-            shape: self.mpm.shape,
-            scheme: self.mpm.scheme,
-            gravity: self.gravity,
-            courant: self.mpm.courant,
-            dt: self.time.dt,
-            damping: self.mpm.damping,
-            pic_fraction: self.mpm.pic_fraction,
-            resort_every: self.mpm.resort_every,
-        };
+        let params = self.mpm.params(self.gravity, self.time.dt);
         let mut mpm = Mpm::new(grid, pts, material, params)?;
         mpm.set_transfer(self.mpm.transfer)?;
-        let given = self.initial.as_ref().map(|i| i.compile()).transpose()?;
-        let Some(given) = given else {
-            mpm.set_stress(initial)?;
-            return Ok(mpm);
-        };
-        given.check(&mpm.points.pos)?;
-        mpm.set_stress(|x| given.stress(x).unwrap_or_else(|| initial(x)))?;
-        let p = &mut mpm.points;
-        for (v, &x) in p.vel.iter_mut().zip(&p.pos) {
-            if let Some(u) = given.velocity(x) {
-                *v = u;
-            }
-        }
+        start(&mut mpm, self.initial.as_ref(), initial)?;
         Ok(mpm)
     }
 }
@@ -755,8 +756,12 @@ impl DerivedMpm {
                 .saturating_mul(RVE_BYTES_PER_GRAIN),
             Law::Continuum(_) => 0,
         };
-        (8usize << 20)
-            .saturating_add(self.points.saturating_mul(1434))
-            .saturating_add(volumes)
+        point_memory(self.points).saturating_add(volumes)
     }
+}
+
+/// Estimated peak memory (bytes) of an MPM run with closed-form laws: 8 MiB + 1.4 KiB per
+/// point (see [`DerivedMpm::memory_bytes`]).
+pub fn point_memory(points: usize) -> usize {
+    (8usize << 20).saturating_add(points.saturating_mul(1434))
 }

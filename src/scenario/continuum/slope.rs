@@ -158,15 +158,14 @@ pub fn run(fidelity: Fidelity) -> Result<Report> {
     let speeds = |o: &Onset| -> Vec<(f64, f64)> {
         o.rows
             .iter()
-            .filter(|r| r.1 > 0.0)
+            .filter(|r| r.1 > 1e-6)
             .map(|&(b, v)| (b, v))
             .collect()
     };
     let plot = Plot::new(
         "mpm-slope-onset",
         &format!(
-            "Infinite slope on a tilting table, φ = {phi}°: sliding from {:.2}° (ψ = φ; tan φ/tan β \
-             = 1 at {phi}°) and {:.2}° (ψ = 0; arctan(sin φ) = {davis:.2}°)",
+            "Infinite slope, φ = {phi}°: sliding from {:.2}° (ψ = φ) and {:.2}° (ψ = 0)",
             associated.extrapolated, plain.extrapolated
         ),
         "slope angle β (°)",
@@ -176,11 +175,11 @@ pub fn run(fidelity: Fidelity) -> Result<Report> {
     .with(Series::line("MPM, ψ = φ", speeds(&associated)).decimated(600))
     .with(Series::line("MPM, ψ = 0", speeds(&plain)).decimated(600))
     .with(Series::dashed(
-        "β = φ",
+        "β = φ (tan φ / tan β = 1)",
         vec![(phi, 1e-6), (phi, 1.0)],
     ))
     .with(Series::dashed(
-        "β = arctan(sin φ)",
+        "β = arctan(sin φ) (Davis)",
         vec![(davis, 1e-6), (davis, 1.0)],
     ));
     Ok(Report {

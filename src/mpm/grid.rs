@@ -11,6 +11,13 @@
 use super::boundary::{Side, Wall};
 use crate::{Error, Result};
 
+/// Whether node `n` of a grid with `nny` nodes per column and the period `period_x` is one of
+/// the period's own nodes ([`Grid::owns`]).
+#[inline(always)]
+pub fn owned(period_x: Option<(usize, usize)>, nny: usize, n: usize) -> bool {
+    period_x.is_none_or(|(c0, cells)| (c0..c0 + cells).contains(&(n / nny)))
+}
+
 /// Per-node accumulators of the particle-to-grid transfer: mass, momentum (x, y), force (x, y).
 pub type NodeSums = [f64; 5];
 
@@ -112,10 +119,7 @@ impl Grid {
     /// the grid (mass, momentum, wall work) count these only.
     #[inline(always)]
     pub fn owns(&self, n: usize) -> bool {
-        match self.period_x {
-            None => true,
-            Some((c0, cells)) => (c0..c0 + cells).contains(&(n / self.nny())),
-        }
+        owned(self.period_x, self.nny(), n)
     }
 
     /// Periodic in x: add each image column's sums (components `which`) into its column of

@@ -2,7 +2,7 @@
 //! Mohr–Coulomb plasticity (thesis chapter 4; Bardenhagen & Kober 2004; Sulsky et al. 1995).
 //!
 //! * [`shape`]: uGIMP and standard MPM shape functions (node support sketched there);
-//! * [`grid`]: the background grid (x-major node arrays);
+//! * [`grid`]: the background grid (x-major node arrays), optionally periodic in x;
 //! * [`points`]: material points as a structure of arrays;
 //! * [`boundary`]: fixed, roller and Coulomb-frictional walls on grid nodes;
 //! * [`material`]: the material contract `update_stress(σ, Δε, Δω, state) → σ` (Jaumann

@@ -240,8 +240,7 @@ impl<M: Material> Mpm<M> {
         let (eps, dt, alpha) = (self.mass_eps, self.dt, self.params.damping);
         let walls = &g.walls;
         let (period, nny) = (g.period_x, g.nny());
-        let owns =
-            |n: usize| period.is_none_or(|(c0, cells)| (c0..c0 + cells).contains(&(n / nny)));
+        let owns = |n: usize| crate::mpm::grid::owned(period, nny, n);
         let node = |vn: &mut [f64; 2], v: &[f64; 2], s: &[f64; 5], mask, engaged: &mut u8| {
             if s[0] <= eps {
                 *vn = [0.0; 2];

@@ -31,7 +31,7 @@ pub struct ContinuumSummary {
     pub points: usize,
     /// Cells of the domain (x, y).
     pub cells: [usize; 2],
-    /// The step (s) and the steps taken.
+    /// The step (s).
     pub dt: f64,
     /// Steps taken.
     pub steps: u64,

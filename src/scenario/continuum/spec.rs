@@ -28,7 +28,7 @@ use crate::scenario::{positive, Kind, ScenarioFile};
 use crate::{Error, Result};
 
 /// Most material points or grid cells a continuum scenario may hold.
-const MAX_POINTS: f64 = 2e7;
+const MAX_POINTS: f64 = 1e7;
 
 /// An MPM scenario of any geometry, as read from TOML. All values SI (angles in degrees).
 #[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]

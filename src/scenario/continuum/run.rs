@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::spec::{ContinuumScenario, DerivedContinuum};
+use super::spec::{angle_deg, ContinuumScenario, DerivedContinuum};
 use crate::exec::Progress;
 use crate::io::{write_json, CsvWriter, PvdEntry, PvdSeries};
 use crate::mpm::Mpm;
@@ -75,11 +75,6 @@ pub fn motion(mpm: &Mpm) -> (f64, [f64; 2], f64) {
         vmax = vmax.max(s2.sqrt());
     }
     (ke, [mv[0] / m, mv[1] / m], vmax)
-}
-
-/// The angle of `g` from −y (degrees, positive towards +x).
-fn angle_deg(g: [f64; 2]) -> f64 {
-    g[0].atan2(-g[1]).to_degrees()
 }
 
 /// Advance `mpm` by `steps` steps, turning the gravity to [`ContinuumScenario::gravity_at`]

@@ -23,7 +23,7 @@
 //! (docs/validation.md).
 
 use super::run::{advance, motion};
-use super::spec::ContinuumScenario;
+use super::spec::{angle_deg, ContinuumScenario};
 use crate::analysis::powerlaw::linear_fit;
 use crate::report::{Check, Fidelity, Plot, Report, Series};
 use crate::scenario::mpm::spec::MaterialSpec;
@@ -55,7 +55,7 @@ fn tilt(s: &ContinuumScenario) -> Result<Onset> {
     let mut rows = Vec::new();
     loop {
         let g = s.gravity_at(&d, mpm.time());
-        let beta = g[0].atan2(-g[1]).to_degrees();
+        let beta = angle_deg(g);
         let v = motion(&mpm).1[0];
         rows.push((beta, v));
         if v > 10.0 * v_lo {

@@ -20,7 +20,7 @@ use crate::mpm::boundary::{Side, Wall, WallKind};
 use crate::mpm::grid::Grid;
 use crate::mpm::material::{Material, MaterialModel};
 use crate::mpm::points::Points;
-use crate::mpm::solver::Mpm;
+use crate::mpm::solver::{cfl_step, Mpm};
 use crate::scenario::granular::spec::region_vertices;
 use crate::scenario::mpm::initial::{start, MpmInitialSpec};
 use crate::scenario::mpm::spec::{check_wall, point_memory, Law, MaterialSpec, MpmSpec};
@@ -154,6 +154,11 @@ impl ScenarioFile for ContinuumScenario {
     const KIND: Kind = Kind::Continuum;
 }
 
+/// The angle of `g` from −y (degrees, positive towards +x).
+pub fn angle_deg(g: [f64; 2]) -> f64 {
+    g[0].atan2(-g[1]).to_degrees()
+}
+
 /// The number of cells of size `h` in `[a, b]`, if whole (to 1e-6 of a cell).
 fn cells_in(a: f64, b: f64, h: f64) -> Option<usize> {
     let n = (b - a) / h;
@@ -168,7 +173,7 @@ impl ContinuumScenario {
             return Err(Error::config("gravity", "must be finite"));
         }
         let g_abs = g[0].hypot(g[1]);
-        let angle_deg = g[0].atan2(-g[1]).to_degrees();
+        let angle_deg = angle_deg(g);
         if let Some(t) = &self.tilt {
             positive("tilt.rate_deg_per_s", t.rate_deg_per_s)?;
             positive("tilt.onset_speed", t.onset_speed)?;
@@ -286,7 +291,7 @@ impl ContinuumScenario {
                 format!("the regions hold no point of the lattice of {n} × {n} points per cell"),
             ));
         }
-        let limit = self.mpm.courant * h / (material.p_wave_modulus() / material.density()).sqrt();
+        let limit = cfl_step(&material, h, self.mpm.courant);
         let dt = match self.time.dt {
             Some(dt) => {
                 positive("time.dt", dt)?;

@@ -99,11 +99,11 @@ pub struct Lattice<T> {
     solid: Vec<bool>,
     edges: Edges,
     /// Bounce-back correction 6 w_i ρ₀ (e_i·u_w) per wall velocity; entry 0 is a wall at rest.
-    wall_corr: Vec<[T; Q]>,
+    pub(super) wall_corr: Vec<[T; Q]>,
     rows: Vec<RowPlan>,
     pub(crate) specials: Vec<Special>,
     /// For each cell, its index in `specials` or `u32::MAX`.
-    special_of: Vec<u32>,
+    pub(super) special_of: Vec<u32>,
     /// True when the next step is even.
     even: bool,
     /// Half the body force, F/2 (lattice units), by which the Zou–He closure shifts the

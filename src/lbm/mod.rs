@@ -8,12 +8,15 @@
 //! * [`covered`]: the hook through which a coupling method collides the cells its solids
 //!   cover (partially saturated cells live in `crate::coupling::psm`, Ladd's bounce-back in
 //!   `crate::coupling::ladd`).
+//! * `gpu` (feature `gpu`): the same step on a GPU through wgpu.
 //! * [`solver`]: the solver in time, built from an [`LbmSetup`].
 
 pub mod boundary;
 pub mod collision;
 pub mod covered;
 pub mod d2q9;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod lattice;
 pub mod obstacle;
 pub mod real;

@@ -22,6 +22,8 @@ mod dem_rapier;
 mod dem_scenario;
 mod dem_shear;
 mod fuzz_scenarios;
+#[cfg(feature = "gpu")]
+mod gpu;
 mod granular;
 mod io_vtk;
 mod models;

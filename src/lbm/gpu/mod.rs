@@ -1,0 +1,436 @@
+//! The lattice Boltzmann step on a GPU through wgpu (feature `gpu`).
+//!
+//! The device holds the populations in the CPU's layout (structure of arrays, padded stride,
+//! [`super::lattice`]) and runs the same in-place AA stream–collide (`stream_collide.wgsl`),
+//! one thread per cell, one dispatch per step. AA rather than two copies (A→B): it halves the
+//! device memory, moves the same 2·9 values per cell and step, and leaves the populations in
+//! exactly the CPU's state (values and parity), so a download is a CPU lattice again: frames,
+//! probes, stability checks and checkpoints use the CPU code unchanged, and a checkpoint taken
+//! on one back end resumes on the other.
+//!
+//! Nodes whose 8 neighbours are fluid ("bulk") find their neighbours by index arithmetic;
+//! the others ("special": next to a wall or a solid) read a table of 9 link codes built from
+//! the CPU lattice's own plan, so both back ends apply the same bounce-back on the same
+//! links. The populations stay on the device between steps; [`GpuFluid`] downloads them only
+//! when something is observed (a frame, a probe, a check, a checkpoint).
+//!
+//! Built: BGK and MRT, Smagorinsky LES, Guo forcing, periodic edges, half-way bounce-back
+//! walls at rest or moving, in f32, and in f64 where the adapter offers `SHADER_F64`. Refused
+//! with the reason (run them with `backend = "cpu"`): Zou–He edges and obstacles.
+
+use std::cell::{Cell, Ref, RefCell};
+
+use wgpu::util::DeviceExt;
+
+use super::boundary::Neighbour;
+use super::collision::{Collider, CollisionModel};
+use super::d2q9::Q;
+use super::lattice::Lattice;
+use super::real::Real;
+use super::solver::{Fluid, Lbm, LbmState, Macroscopic};
+use crate::units::Units;
+use crate::Result;
+
+/// The kernel's source, with `alias real = f32;` rewritten for f64.
+const SOURCE: &str = include_str!("stream_collide.wgsl");
+/// Threads per workgroup along x (the kernel's `@workgroup_size`).
+const GROUP_X: u32 = 64;
+/// Steps encoded into one command buffer.
+const STEPS_PER_SUBMIT: u64 = 256;
+/// `kind` of a bulk cell and of a solid cell (`stream_collide.wgsl`).
+const BULK: u32 = u32::MAX;
+const SOLID: u32 = u32::MAX - 1;
+/// Link-code bit of a bounce-back link.
+const BOUNCE: u32 = 1 << 31;
+
+/// A population type the device can hold: `f32`, or `f64` with `SHADER_F64`.
+pub trait DeviceReal: Real + bytemuck::Pod {}
+impl<T: Real + bytemuck::Pod> DeviceReal for T {}
+
+/// A GPU: the adapter wgpu picked, its device and queue.
+pub struct Gpu {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    /// The adapter's name and driver, for reports.
+    pub name: String,
+    /// Does the adapter offer `SHADER_F64`?
+    pub f64: bool,
+}
+
+impl Gpu {
+    /// The highest-performance adapter among Vulkan, Metal and DX12 ones, with its largest
+    /// limits. Fails with what was looked for when there is none.
+    pub fn new() -> std::result::Result<Gpu, String> {
+        let instance = wgpu::Instance::new(&wgpu::InstanceDescriptor {
+            backends: wgpu::Backends::PRIMARY,
+            ..Default::default()
+        });
+        let options = wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+        };
+        let adapter = pollster::block_on(instance.request_adapter(&options)).map_err(|e| {
+            format!(
+                "no GPU adapter found ({e}): looked for Vulkan, Metal and DX12 adapters through \
+                 wgpu; install the GPU's Vulkan driver (without a GPU, a software one such as \
+                 Debian's mesa-vulkan-drivers), or run with backend = \"cpu\""
+            )
+        })?;
+        let info = adapter.get_info();
+        let f64 = adapter.features().contains(wgpu::Features::SHADER_F64);
+        let features = if f64 {
+            wgpu::Features::SHADER_F64
+        } else {
+            wgpu::Features::empty()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("granflow"),
+            required_features: features,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|e| format!("the GPU adapter {} refused a device: {e}", info.name))?;
+        Ok(Gpu {
+            device,
+            queue,
+            name: format!("{} ({:?}, {})", info.name, info.backend, info.driver_info),
+            f64,
+        })
+    }
+}
+
+/// A lattice's populations on the device and the two pipelines (even, odd step) that advance
+/// them.
+pub struct GpuLattice {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    /// Pipelines of the odd and the even step.
+    pipelines: [wgpu::ComputePipeline; 2],
+    bind_group: wgpu::BindGroup,
+    f: wgpu::Buffer,
+    groups: [u32; 2],
+    /// True when the next step is even.
+    even: bool,
+}
+
+impl GpuLattice {
+    /// Upload `lattice` (populations, parity, walls) and build the kernel for `collider`.
+    /// Fails with the reason for what the device path does not have (Zou–He edges, f64
+    /// without `SHADER_F64`, a lattice larger than the adapter's buffers).
+    pub fn new<T: DeviceReal>(
+        gpu: &Gpu,
+        lattice: &Lattice<T>,
+        collider: &Collider<T>,
+    ) -> std::result::Result<Self, String> {
+        if T::NAME == "f64" && !gpu.f64 {
+            return Err(format!(
+                "the GPU adapter {} lacks the SHADER_F64 feature that f64 populations need: \
+                 use precision = \"f32\" or backend = \"cpu\"",
+                gpu.name
+            ));
+        }
+        if lattice.specials.iter().any(|s| s.zou_he.is_some()) {
+            return Err(
+                "Zou-He (velocity or pressure) edges are not built on the GPU back end yet: \
+                 use backend = \"cpu\""
+                    .into(),
+            );
+        }
+        let (nx, ny) = (lattice.nx, lattice.ny);
+        let (pops, even) = lattice.state();
+        let stride = pops.len() / Q;
+        let limits = gpu.device.limits();
+        let bytes = std::mem::size_of_val(pops.as_slice()) as u64;
+        if bytes > u64::from(limits.max_storage_buffer_binding_size) || stride >= BOUNCE as usize {
+            return Err(format!(
+                "the lattice's populations ({} MiB) exceed the GPU adapter's largest storage \
+                 buffer ({} MiB): use a smaller lattice or backend = \"cpu\"",
+                bytes >> 20,
+                limits.max_storage_buffer_binding_size >> 20
+            ));
+        }
+        if ny as u32 > limits.max_compute_workgroups_per_dimension {
+            return Err(format!(
+                "the lattice has {ny} rows, more than the GPU adapter dispatches ({})",
+                limits.max_compute_workgroups_per_dimension
+            ));
+        }
+        let kind: Vec<u32> = (0..nx * ny)
+            .map(|c| match lattice.special_of[c] {
+                _ if lattice.is_solid(c) => SOLID,
+                u32::MAX => BULK,
+                s => s,
+            })
+            .collect();
+        let mut links: Vec<u32> = lattice
+            .specials
+            .iter()
+            .flat_map(|s| {
+                s.nb.map(|nb| match nb {
+                    Neighbour::Fluid(k) => k,
+                    Neighbour::Bounce(w) => BOUNCE | u32::from(w),
+                    Neighbour::Open => unreachable!("Zou-He lattices are refused above"),
+                })
+            })
+            .collect();
+        // A binding may not be empty.
+        links.resize(links.len().max(Q), 0);
+        let corr: Vec<T> = lattice.wall_corr.iter().flatten().copied().collect();
+        let s = match collider.model {
+            CollisionModel::Bgk => [0.0; 3],
+            CollisionModel::Mrt(r) => [r.s_e, r.s_eps, r.s_q],
+        };
+        let coef: Vec<T> = [
+            1.0 / collider.tau,
+            collider.tau,
+            18.0 * collider.smagorinsky.unwrap_or(0.0).powi(2),
+            collider.force[0],
+            collider.force[1],
+            s[0],
+            s[1],
+            s[2],
+        ]
+        .map(T::c)
+        .to_vec();
+
+        let device = gpu.device.clone();
+        let storage = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE | usage,
+            })
+        };
+        let copy = wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let read = wgpu::BufferUsages::empty();
+        let f = storage("populations", bytemuck::cast_slice(&pops), copy);
+        let buffers = [
+            &f,
+            &storage("kind", bytemuck::cast_slice(&kind), read),
+            &storage("links", bytemuck::cast_slice(&links), read),
+            &storage("wall terms", bytemuck::cast_slice(&corr), read),
+            &storage("collision", bytemuck::cast_slice(&coef), read),
+        ];
+        let source = SOURCE.replacen(
+            "alias real = f32;",
+            &format!("alias real = {};", T::NAME),
+            1,
+        );
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("stream_collide.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        // Binding 0 (the populations) is written, the others are read.
+        let layout_entries: Vec<wgpu::BindGroupLayoutEntry> = (0..buffers.len() as u32)
+            .map(|binding| wgpu::BindGroupLayoutEntry {
+                binding,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage {
+                        read_only: binding > 0,
+                    },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            })
+            .collect();
+        let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("lattice"),
+            entries: &layout_entries,
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("lattice"),
+            bind_group_layouts: &[&group_layout],
+            push_constant_ranges: &[],
+        });
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        let pipeline = |even: bool| {
+            let constants = [
+                ("NX", nx as f64),
+                ("NY", ny as f64),
+                ("STRIDE", stride as f64),
+                ("EVEN", flag(even)),
+                (
+                    "MRT",
+                    flag(matches!(collider.model, CollisionModel::Mrt(_))),
+                ),
+                ("LES", flag(collider.smagorinsky.is_some())),
+                ("FORCE", flag(collider.force != [0.0, 0.0])),
+            ];
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(if even { "even step" } else { "odd step" }),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some("stream_collide"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    zero_initialize_workgroup_memory: false,
+                },
+                cache: None,
+            })
+        };
+        let pipelines = [pipeline(false), pipeline(true)];
+        let entries: Vec<wgpu::BindGroupEntry> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("lattice"),
+            layout: &group_layout,
+            entries: &entries,
+        });
+        Ok(GpuLattice {
+            device,
+            queue: gpu.queue.clone(),
+            pipelines,
+            bind_group,
+            f,
+            groups: [(nx as u32).div_ceil(GROUP_X), ny as u32],
+            even,
+        })
+    }
+
+    /// Advance `steps` steps on the device (nothing is read back).
+    pub fn run(&mut self, steps: u64) {
+        let mut left = steps;
+        while left > 0 {
+            let batch = left.min(STEPS_PER_SUBMIT);
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                pass.set_bind_group(0, &self.bind_group, &[]);
+                for _ in 0..batch {
+                    pass.set_pipeline(&self.pipelines[usize::from(self.even)]);
+                    pass.dispatch_workgroups(self.groups[0], self.groups[1], 1);
+                    self.even = !self.even;
+                }
+            }
+            self.queue.submit([encoder.finish()]);
+            left -= batch;
+        }
+    }
+
+    /// Wait until every step submitted so far has run.
+    pub fn finish(&self) {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("the GPU device was lost");
+    }
+
+    /// Copy the device's populations and parity into `lattice` (built like the uploaded one).
+    pub fn download<T: DeviceReal>(&self, lattice: &mut Lattice<T>) {
+        let size = self.f.size();
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("read back"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&self.f, 0, &staging, 0, size);
+        self.queue.submit([encoder.finish()]);
+        let slice = staging.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |r| {
+            r.expect("mapping the GPU's populations for reading failed")
+        });
+        self.finish();
+        let pops: Vec<T> = bytemuck::cast_slice(&slice.get_mapped_range()).to_vec();
+        staging.unmap();
+        lattice.set_state(pops, self.even);
+    }
+
+    /// Replace the device's populations and parity by `lattice`'s.
+    pub fn upload<T: DeviceReal>(&mut self, lattice: &Lattice<T>) {
+        let (pops, even) = lattice.state();
+        self.queue
+            .write_buffer(&self.f, 0, bytemuck::cast_slice(&pops));
+        self.even = even;
+    }
+}
+
+/// A fluid that steps on the GPU: [`Fluid`] over a [`GpuLattice`] and a host copy of the
+/// solver, refreshed from the device only when something is observed.
+pub struct GpuFluid<T> {
+    host: RefCell<Lbm<T>>,
+    device: GpuLattice,
+    /// True when the device is ahead of the host copy.
+    stale: Cell<bool>,
+}
+
+impl<T: DeviceReal> GpuFluid<T> {
+    /// Move `lbm` onto the GPU. Fails with the reason for what the device path does not have
+    /// (see the module docs).
+    pub fn new(gpu: &Gpu, lbm: Lbm<T>) -> std::result::Result<Self, String> {
+        if !lbm.obstacles.list.is_empty() {
+            return Err(
+                "obstacles are not built on the GPU back end yet: use backend = \"cpu\"".into(),
+            );
+        }
+        let device = GpuLattice::new(gpu, &lbm.lattice, &lbm.collider)?;
+        Ok(GpuFluid {
+            host: RefCell::new(lbm),
+            device,
+            stale: Cell::new(false),
+        })
+    }
+
+    /// The host copy, brought up to date with the device.
+    pub fn host(&self) -> Ref<'_, Lbm<T>> {
+        if self.stale.get() {
+            self.device.download(&mut self.host.borrow_mut().lattice);
+            self.stale.set(false);
+        }
+        self.host.borrow()
+    }
+}
+
+impl<T: DeviceReal> Fluid for GpuFluid<T> {
+    fn steps(&mut self, n: u64) {
+        self.device.run(n);
+        self.host.get_mut().steps += n;
+        self.stale.set(true);
+    }
+    fn step_count(&self) -> u64 {
+        self.host.borrow().steps
+    }
+    fn units(&self) -> Units {
+        self.host.borrow().units
+    }
+    fn macroscopic(&self, m: &mut Macroscopic) {
+        self.host().macroscopic_into(m)
+    }
+    fn cell_state(&self, c: usize) -> (f64, f64, f64) {
+        self.host().cell(c)
+    }
+    fn obstacle_loads(&self) -> (Vec<[f64; 2]>, Vec<f64>) {
+        (Vec::new(), Vec::new())
+    }
+    fn total_mass(&self) -> f64 {
+        self.host().lattice.total_mass()
+    }
+    fn check_stable(&self, max_mach: f64) -> Result<()> {
+        Fluid::check_stable(&*self.host(), max_mach)
+    }
+    fn bytes(&self) -> usize {
+        self.host.borrow().lattice.bytes()
+    }
+    fn precision(&self) -> &'static str {
+        T::NAME
+    }
+    fn state(&self) -> LbmState {
+        self.host().state()
+    }
+    fn set_state(&mut self, s: LbmState) -> Result<()> {
+        let host = self.host.get_mut();
+        host.set_state(s)?;
+        self.device.upload(&host.lattice);
+        self.stale.set(false);
+        Ok(())
+    }
+}

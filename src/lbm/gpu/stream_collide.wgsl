@@ -1,0 +1,257 @@
+// Fused stream–collide of the D2Q9 lattice, AA pattern in place (one thread per cell).
+//
+// The same step as the CPU's `lbm::lattice` (whose module docs give the pattern) on the same
+// storage: f[i·STRIDE + y·NX + x], one array per direction. Even step: a node reads its own slots,
+// f_i = A[x][i], collides and writes A[x][ī] = f_i*. Odd step: it reads f_i = A[x − e_i][ī] and
+// writes A[x + e_i][i] = f_i*; across a half-way bounce-back link it reads its own slot plus the
+// moving-wall term and writes back into its own opposite slot (seed eq. 5.24, Ladd 1994).
+//
+// `real` is f32, or f64 where the adapter has SHADER_F64 (the host rewrites the alias).
+// Collision operators are those of `lbm::collision` term for term (see its docs for the
+// equations): BGK or MRT (Lallemand & Luo 2000), each with Smagorinsky LES and Guo forcing.
+
+alias real = f32;
+
+// Cells along x and y, direction-array stride: fixed per lattice.
+override NX: u32;
+override NY: u32;
+override STRIDE: u32;
+// Parity of the step this pipeline runs, and the collision variant.
+override EVEN: bool;
+override MRT: bool;
+override LES: bool;
+override FORCE: bool;
+
+// `kind[c]`: a cell whose 8 neighbours are plain fluid, a solid cell, or an index into `links`.
+const BULK: u32 = 0xffffffffu;
+const SOLID: u32 = 0xfffffffeu;
+// A link code with this bit set is a bounce-back link; the low bits number its wall velocity.
+const BOUNCE: u32 = 0x80000000u;
+
+@group(0) @binding(0) var<storage, read_write> f: array<real>;
+@group(0) @binding(1) var<storage, read> kind: array<u32>;
+// Per special node, 9 codes: what lies at x + e_i (a fluid cell index or BOUNCE | wall).
+@group(0) @binding(2) var<storage, read> links: array<u32>;
+// Per wall velocity, 9 values 6 w_i (e_i·u_w) (entry 0: a wall at rest).
+@group(0) @binding(3) var<storage, read> corr: array<real>;
+// ω = 1/τ, τ, 18 C², F_x, F_y, s_e, s_ε, s_q.
+@group(0) @binding(4) var<storage, read> coef: array<real>;
+
+const CX = array<i32, 9>(0, 1, 0, -1, 0, 1, -1, -1, 1);
+const CY = array<i32, 9>(0, 0, 1, 0, -1, 1, 1, -1, -1);
+const OPP = array<u32, 9>(0u, 3u, 4u, 1u, 2u, 7u, 8u, 5u, 6u);
+const W0: real = 4.0 / 9.0;
+const W1: real = 1.0 / 9.0;
+const W5: real = 1.0 / 36.0;
+
+// The cell at (x + dx, y + dy), wrapped (bulk cells have all 8 neighbours in the fluid).
+fn shifted(x: u32, y: u32, dx: i32, dy: i32) -> u32 {
+    let tx = u32((i32(x) + dx + i32(NX)) % i32(NX));
+    let ty = u32((i32(y) + dy + i32(NY)) % i32(NY));
+    return ty * NX + tx;
+}
+
+// 1/τ* with τ* = ½ [τ + √(τ² + 18 C² |Π^neq| / ρ)] under LES, else ω.
+fn rate(rho: real, pxx: real, pyy: real, pxy: real) -> real {
+    if (!LES) {
+        return coef[0];
+    }
+    let pi = sqrt(pxx * pxx + pyy * pyy + 2.0 * pxy * pxy);
+    let tau_t = coef[1];
+    let tau = 0.5 * (tau_t + sqrt(tau_t * tau_t + coef[2] * pi / rho));
+    return 1.0 / tau;
+}
+
+// f₀* = ρ − Σ_{i≥1} f_i*: mass conserved in floating point too.
+fn rest_from_mass(rho: real, f: array<real, 9>) -> real {
+    return rho - (((f[1] + f[2]) + (f[3] + f[4])) + ((f[5] + f[6]) + (f[7] + f[8])));
+}
+
+fn bgk(g: array<real, 9>) -> array<real, 9> {
+    var o: array<real, 9>;
+    let fx = select(0.0, coef[3], FORCE);
+    let fy = select(0.0, coef[4], FORCE);
+    let rho = g[0] + g[1] + g[2] + g[3] + g[4] + g[5] + g[6] + g[7] + g[8];
+    let jx = g[1] - g[3] + g[5] - g[6] - g[7] + g[8];
+    let jy = g[2] - g[4] + g[5] + g[6] - g[7] - g[8];
+    let inv = 1.0 / rho;
+    let ux = (jx + 0.5 * fx) * inv;
+    let uy = (jy + 0.5 * fy) * inv;
+    var omega = coef[0];
+    if (LES) {
+        let third: real = 1.0 / 3.0;
+        let pxx = g[1] + g[3] + g[5] + g[6] + g[7] + g[8] - rho * (third + ux * ux);
+        let pyy = g[2] + g[4] + g[5] + g[6] + g[7] + g[8] - rho * (third + uy * uy);
+        let pxy = g[5] - g[6] + g[7] - g[8] - rho * ux * uy;
+        omega = rate(rho, pxx, pyy, pxy);
+    }
+    let keep = 1.0 - omega;
+    let base = 1.0 - 1.5 * (ux * ux + uy * uy);
+    let r0 = omega * W0 * rho;
+    let r1 = omega * W1 * rho;
+    let r5 = omega * W5 * rho;
+    let t1 = 3.0 * r1;
+    let t5 = 3.0 * r5;
+    o[0] = keep * g[0] + r0 * base;
+    // f_i^eq = w_i ρ (1 − 1.5|u|² + 4.5 (e_i·u)²) ± 3 w_i ρ e_i·u for the pair (i, ī).
+    let cu = array<real, 4>(ux, uy, ux + uy, uy - ux);
+    let r = array<real, 4>(r1, r1, r5, r5);
+    let t = array<real, 4>(t1, t1, t5, t5);
+    let first = array<u32, 4>(1u, 2u, 5u, 6u);
+    for (var p = 0u; p < 4u; p++) {
+        let i = first[p];
+        let even = r[p] * fma(4.5, cu[p] * cu[p], base);
+        let odd = t[p] * cu[p];
+        o[i] = fma(keep, g[i], even + odd);
+        o[OPP[i]] = fma(keep, g[OPP[i]], even - odd);
+    }
+    if (FORCE) {
+        // Guo: (1 − ω/2) w_i [3(e_i − u)·F + 9(e_i·u)(e_i·F)].
+        let fk = 1.0 - 0.5 * omega;
+        let uf = ux * fx + uy * fy;
+        for (var i = 0u; i < 9u; i++) {
+            let ex = real(CX[i]);
+            let ey = real(CY[i]);
+            let w = select(select(W5, W1, i < 5u), W0, i == 0u);
+            let ci = ex * ux + ey * uy;
+            let cf = ex * fx + ey * fy;
+            o[i] = o[i] + fk * w * (3.0 * (cf - uf) + 9.0 * ci * cf);
+        }
+    }
+    o[0] = rest_from_mass(rho, o);
+    return o;
+}
+
+fn mrt(g: array<real, 9>) -> array<real, 9> {
+    let fx = select(0.0, coef[3], FORCE);
+    let fy = select(0.0, coef[4], FORCE);
+    let s_e = coef[5];
+    let s_eps = coef[6];
+    let s_q = coef[7];
+    let axes = g[1] + g[2] + g[3] + g[4];
+    let diag = g[5] + g[6] + g[7] + g[8];
+    let rho = g[0] + axes + diag;
+    var e = -4.0 * g[0] - axes + 2.0 * diag;
+    var eps = 4.0 * g[0] - 2.0 * axes + diag;
+    var jx = g[1] - g[3] + g[5] - g[6] - g[7] + g[8];
+    var qx = -2.0 * g[1] + 2.0 * g[3] + g[5] - g[6] - g[7] + g[8];
+    var jy = g[2] - g[4] + g[5] + g[6] - g[7] - g[8];
+    var qy = -2.0 * g[2] + 2.0 * g[4] + g[5] + g[6] - g[7] - g[8];
+    var pxx = g[1] - g[2] + g[3] - g[4];
+    var pxy = g[5] - g[6] + g[7] - g[8];
+    let inv = 1.0 / rho;
+    let ux = (jx + 0.5 * fx) * inv;
+    let uy = (jy + 0.5 * fy) * inv;
+    let u2 = ux * ux + uy * uy;
+    // Non-equilibrium parts of the moments.
+    let e_n = e - rho * (3.0 * u2 - 2.0);
+    let eps_n = eps - rho * (1.0 - 3.0 * u2);
+    let qx_n = qx + rho * ux;
+    let qy_n = qy + rho * uy;
+    let pxx_n = pxx - rho * (ux * ux - uy * uy);
+    let pxy_n = pxy - rho * ux * uy;
+    var s_nu = coef[0];
+    if (LES) {
+        let a = e_n * (1.0 / 6.0);
+        let b = 0.5 * pxx_n;
+        s_nu = rate(rho, a + b, a - b, pxy_n);
+    }
+    e = e - s_e * e_n;
+    eps = eps - s_eps * eps_n;
+    qx = qx - s_q * qx_n;
+    qy = qy - s_q * qy_n;
+    pxx = pxx - s_nu * pxx_n;
+    pxy = pxy - s_nu * pxy_n;
+    if (FORCE) {
+        let uf = ux * fx + uy * fy;
+        e = e + (1.0 - 0.5 * s_e) * 6.0 * uf;
+        eps = eps - (1.0 - 0.5 * s_eps) * 6.0 * uf;
+        jx = jx + fx;
+        jy = jy + fy;
+        qx = qx - (1.0 - 0.5 * s_q) * fx;
+        qy = qy - (1.0 - 0.5 * s_q) * fy;
+        pxx = pxx + (1.0 - 0.5 * s_nu) * 2.0 * (ux * fx - uy * fy);
+        pxy = pxy + (1.0 - 0.5 * s_nu) * (ux * fy + uy * fx);
+    }
+    // f = M⁻¹ m = Mᵀ diag(1/9, 1/36, 1/36, 1/6, 1/12, 1/6, 1/12, 1/4, 1/4) m.
+    let a = rho * (1.0 / 9.0);
+    let b = e * (1.0 / 36.0);
+    let c = eps * (1.0 / 36.0);
+    let d = jx * (1.0 / 6.0);
+    let gq = qx * (1.0 / 12.0);
+    let h = jy * (1.0 / 6.0);
+    let k = qy * (1.0 / 12.0);
+    let p = pxx * 0.25;
+    let s = pxy * 0.25;
+    let ax = a - b - 2.0 * c;
+    let dg = a + 2.0 * b + c;
+    var o: array<real, 9>;
+    o[1] = ax + d - 2.0 * gq + p;
+    o[2] = ax + h - 2.0 * k - p;
+    o[3] = ax - d + 2.0 * gq + p;
+    o[4] = ax - h + 2.0 * k - p;
+    o[5] = dg + d + gq + h + k + s;
+    o[6] = dg - d - gq + h + k - s;
+    o[7] = dg - d - gq - h - k + s;
+    o[8] = dg + d + gq - h - k - s;
+    o[0] = rest_from_mass(rho, o);
+    return o;
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn stream_collide(@builtin(global_invocation_id) id: vec3<u32>) {
+    let x = id.x;
+    let y = id.y;
+    if (x >= NX || y >= NY) {
+        return;
+    }
+    let c = y * NX + x;
+    let k = kind[c];
+    if (k == SOLID) {
+        return;
+    }
+    var g: array<real, 9>;
+    if (EVEN) {
+        for (var i = 0u; i < 9u; i++) {
+            g[i] = f[i * STRIDE + c];
+        }
+    } else if (k == BULK) {
+        for (var j = 0u; j < 9u; j++) {
+            g[j] = f[OPP[j] * STRIDE + shifted(x, y, -CX[j], -CY[j])];
+        }
+    } else {
+        // The population arriving along e_j comes across link ī.
+        for (var j = 0u; j < 9u; j++) {
+            let l = links[k * 9u + OPP[j]];
+            if (l < BOUNCE) {
+                g[j] = f[OPP[j] * STRIDE + l];
+            } else {
+                g[j] = f[j * STRIDE + c] + corr[(l & ~BOUNCE) * 9u + j];
+            }
+        }
+    }
+    var o: array<real, 9>;
+    if (MRT) {
+        o = mrt(g);
+    } else {
+        o = bgk(g);
+    }
+    if (EVEN) {
+        for (var i = 0u; i < 9u; i++) {
+            f[OPP[i] * STRIDE + c] = o[i];
+        }
+    } else if (k == BULK) {
+        for (var i = 0u; i < 9u; i++) {
+            f[i * STRIDE + shifted(x, y, CX[i], CY[i])] = o[i];
+        }
+    } else {
+        for (var i = 0u; i < 9u; i++) {
+            let l = links[k * 9u + i];
+            if (l < BOUNCE) {
+                f[i * STRIDE + l] = o[i];
+            } else {
+                f[OPP[i] * STRIDE + c] = o[i] - corr[(l & ~BOUNCE) * 9u + i];
+            }
+        }
+    }
+}

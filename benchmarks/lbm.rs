@@ -14,7 +14,15 @@ fn main() {
     let steps = env("GRANFLOW_BENCH_STEPS", 50) as u64;
     for f64_ in [false, true] {
         for mrt in [false, true] {
-            match granflow::scenario::fluid::bench::lbm(n, n, steps, f64_, mrt, 0, 5) {
+            let case = granflow::scenario::fluid::bench::LbmCase {
+                nx: n,
+                ny: n,
+                steps,
+                f64: f64_,
+                mrt,
+                backend: granflow::lbm::Backend::Cpu,
+            };
+            match granflow::scenario::fluid::bench::lbm(case, 0, 5) {
                 Ok(r) => println!(
                     "lbm {n}² {} {}: {:.1} MLUPS, copy {:.1} GB/s, {:.0} % of roofline",
                     r.precision,

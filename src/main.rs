@@ -40,6 +40,10 @@ enum Command {
         /// repeat for more); the output folder's scenario.toml records it.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<Override>,
+        /// Where a fluid file's lattice steps (kind = "fluid"; the same as --set
+        /// lbm.backend=…; gpu needs a build with --features gpu).
+        #[arg(long, value_enum)]
+        backend: Option<Backend>,
         /// Output folder (created if needed; one that holds an earlier run is refused unless
         /// --force).
         #[arg(long)]
@@ -80,6 +84,10 @@ enum Command {
         /// Write each case's figures as `<DIR>/<name>.svg` (DIR is created if needed).
         #[arg(long, value_name = "DIR")]
         figures: Option<PathBuf>,
+        /// Where the fluid cases step; with gpu, `all` runs the cases the GPU back end has
+        /// (a build with --features gpu).
+        #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+        backend: Backend,
     },
     /// Run a column-collapse sweep (cases in parallel, resumable) and write sweep.csv,
     /// fits.json and the figures.
@@ -233,6 +241,24 @@ pub(crate) enum Precision {
     F64,
 }
 
+/// Where the lattice steps.
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum Backend {
+    /// The CPU (rayon threads).
+    Cpu,
+    /// A GPU through wgpu (a build with `--features gpu`).
+    Gpu,
+}
+
+impl From<Backend> for granflow::lbm::Backend {
+    fn from(b: Backend) -> Self {
+        match b {
+            Backend::Cpu => granflow::lbm::Backend::Cpu,
+            Backend::Gpu => granflow::lbm::Backend::Gpu,
+        }
+    }
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 pub(crate) enum Collision {
     Bgk,
@@ -300,6 +326,10 @@ pub(crate) enum Bench {
         /// Collision operator.
         #[arg(long, value_enum, default_value_t = Collision::Bgk)]
         collision: Collision,
+        /// Where the lattice steps; on the GPU the roofline is the device's own copy
+        /// bandwidth.
+        #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+        backend: Backend,
         /// Threads (0: all cores).
         #[arg(long, default_value_t = 0)]
         threads: usize,
@@ -400,25 +430,34 @@ fn real_main() -> Result<ExitCode> {
         Command::Check { scenario, set } => cli::run::check(&scenario, &set),
         Command::Run {
             scenario,
-            set,
+            mut set,
+            backend,
             out,
             force,
             rve_frames,
             checkpoint_every,
-        } => cli::run::run(
-            &scenario,
-            &set,
-            out_of(&out, force),
-            &rve_frames,
-            checkpoint_every,
-        ),
+        } => {
+            if let Some(b) = backend {
+                let name = granflow::lbm::Backend::from(b).name();
+                let key = format!("lbm.backend=\"{name}\"");
+                set.push(key.parse().map_err(anyhow::Error::msg)?);
+            }
+            cli::run::run(
+                &scenario,
+                &set,
+                out_of(&out, force),
+                &rve_frames,
+                checkpoint_every,
+            )
+        }
         Command::Resume { out } => cli::run::resume(&out),
         Command::Validate {
             case,
             json,
             full,
             figures,
-        } => cli::study::validate(&case, json, full, figures.as_deref()),
+            backend,
+        } => cli::study::validate(&case, json, full, figures.as_deref(), backend.into()),
         Command::Sweep {
             sweep,
             out,

@@ -38,25 +38,30 @@ pub fn bench(which: Bench) -> Result<ExitCode> {
             steps,
             precision,
             collision,
+            backend,
             threads,
             repeats,
             json,
         } => {
-            let r = granflow::scenario::fluid::bench::lbm(
+            let case = granflow::scenario::fluid::bench::LbmCase {
                 nx,
                 ny,
                 steps,
-                matches!(precision, Precision::F64),
-                matches!(collision, Collision::Mrt),
-                threads,
-                repeats,
-            )?;
+                f64: matches!(precision, Precision::F64),
+                mrt: matches!(collision, Collision::Mrt),
+                backend: backend.into(),
+            };
+            let r = granflow::scenario::fluid::bench::lbm(case, threads, repeats)?;
             if json {
                 println!("{}", serde_json::to_string(&r)?);
             } else {
+                let place = match &r.device {
+                    Some(device) => format!("on {device}"),
+                    None => format!("on {} threads", r.threads),
+                };
                 println!(
-                    "lbm {}×{} {} {} on {} threads: {:.1} MLUPS (samples {:?}); copy {:.1} GB/s; {} B/cell; {:.0} % of roofline",
-                    r.nx, r.ny, r.precision, r.collision, r.threads, r.mlups, r.samples.iter().map(|s| (s * 10.0).round() / 10.0).collect::<Vec<_>>(), r.copy_gb_s, r.bytes_per_cell, 100.0 * r.roofline_fraction
+                    "lbm {}×{} {} {} {place}: {:.1} MLUPS (samples {:?}); copy {:.1} GB/s; {} B/cell; {:.0} % of roofline",
+                    r.nx, r.ny, r.precision, r.collision, r.mlups, r.samples.iter().map(|s| (s * 10.0).round() / 10.0).collect::<Vec<_>>(), r.copy_gb_s, r.bytes_per_cell, 100.0 * r.roofline_fraction
                 );
             }
             Ok(ExitCode::SUCCESS)

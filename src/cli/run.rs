@@ -93,6 +93,7 @@ fn check_fluid(s: &Scenario) -> Result<ExitCode> {
         granflow::scenario::fluid::MAX_MACH
     );
     println!("Reynolds        {:.4}", d.reynolds);
+    println!("backend         {}", s.lbm.backend.name());
     println!("steps           {} ({} s)", d.steps, s.time.end);
     println!(
         "frames          every {} steps ({} frames)",

@@ -201,7 +201,13 @@ fn print_check(c: &Check, json: bool) {
     }
 }
 
-pub fn validate(case: &str, json: bool, full: bool, figures: Option<&Path>) -> Result<ExitCode> {
+pub fn validate(
+    case: &str,
+    json: bool,
+    full: bool,
+    figures: Option<&Path>,
+    backend: granflow::lbm::Backend,
+) -> Result<ExitCode> {
     if case == "list" {
         for c in validation::CASES {
             println!("{:<16} {}", c.name, c.description);
@@ -209,7 +215,9 @@ pub fn validate(case: &str, json: bool, full: bool, figures: Option<&Path>) -> R
         return Ok(ExitCode::SUCCESS);
     }
     let fidelity = if full { Fidelity::Full } else { Fidelity::Test };
-    let names: Vec<&str> = if case == "all" {
+    let names: Vec<&str> = if case == "all" && backend == granflow::lbm::Backend::Gpu {
+        validation::ON_ANY_BACKEND.iter().map(|c| c.0).collect()
+    } else if case == "all" {
         validation::CASES.iter().map(|c| c.name).collect()
     } else {
         vec![case]
@@ -225,7 +233,7 @@ pub fn validate(case: &str, json: bool, full: bool, figures: Option<&Path>) -> R
             let so_far = start.elapsed().as_secs_f64();
             eprintln!("[{}/{count}] {name} ({so_far:.0} s so far)", k + 1);
         }
-        match validation::run(name, fidelity) {
+        match validation::run_on(name, fidelity, backend) {
             Ok(report) => {
                 for c in &report.checks {
                     print_check(c, json);

@@ -3,6 +3,7 @@
 //! * [`d2q9`]: velocity set, weights, equilibrium.
 //! * [`collision`]: BGK, MRT, Smagorinsky LES, Guo forcing.
 //! * [`lattice`]: population storage (structure of arrays) and the in-place AA stream–collide.
+//! * [`backend`]: CPU or GPU.
 //! * [`boundary`]: periodic, half-way bounce-back (resting or moving), Zou–He edges.
 //! * [`obstacle`]: shapes, interpolated bounce-back, momentum-exchange forces.
 //! * [`covered`]: the hook through which a coupling method collides the cells its solids
@@ -11,6 +12,7 @@
 //! * `gpu` (feature `gpu`): the same step on a GPU through wgpu.
 //! * [`solver`]: the solver in time, built from an [`LbmSetup`].
 
+pub mod backend;
 pub mod boundary;
 pub mod collision;
 pub mod covered;
@@ -23,6 +25,7 @@ pub mod real;
 pub mod simd;
 pub mod solver;
 
+pub use backend::Backend;
 pub use boundary::{Edge, Edges};
 pub use collision::{Collider, CollisionModel, MrtRates};
 pub use covered::CoveredCells;

@@ -2,9 +2,22 @@
 
 use num_traits::Float;
 
+/// What a GPU buffer needs of its element type (`bytemuck::Pod`); nothing without the `gpu`
+/// feature.
+#[cfg(feature = "gpu")]
+pub trait DeviceValue: bytemuck::Pod {}
+#[cfg(feature = "gpu")]
+impl<T: bytemuck::Pod> DeviceValue for T {}
+/// What a GPU buffer needs of its element type; nothing without the `gpu` feature.
+#[cfg(not(feature = "gpu"))]
+pub trait DeviceValue {}
+#[cfg(not(feature = "gpu"))]
+impl<T> DeviceValue for T {}
+
 /// A population value type. Implemented for `f32` and `f64`.
 pub trait Real:
     Float
+    + DeviceValue
     + Default
     + Send
     + Sync

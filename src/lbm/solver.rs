@@ -317,8 +317,11 @@ impl<T: Real> Lbm<T> {
 
 /// Precision-erased fluid solver, as the CLI and drivers use it.
 pub trait Fluid: Send {
-    /// Advance `n` lattice steps.
+    /// Advance `n` lattice steps (on a GPU: submitted, see [`Fluid::finish`]).
     fn steps(&mut self, n: u64);
+    /// Wait until the steps submitted so far have run (a GPU runs them asynchronously; the
+    /// observing methods wait by themselves).
+    fn finish(&self) {}
     /// Steps taken so far.
     fn step_count(&self) -> u64;
     /// SI ↔ lattice conversion.

@@ -9,6 +9,7 @@ use super::dem::{validation as dem, validation_polygon};
 use super::fluid::validation::{cavity, conservation, cylinder, les, poiseuille, taylor_green};
 use super::mpm::validation as mpm;
 use super::submerged::{validation as psm, validation_ladd as ladd};
+use crate::lbm::Backend;
 use crate::report::{Check, Fidelity, Report};
 use crate::Result;
 
@@ -187,6 +188,39 @@ fn checks_only(checks: Result<Vec<Check>>) -> Result<Report> {
         checks: checks?,
         plots: Vec::new(),
     })
+}
+
+/// A case that runs on either back end: its checks and references are the same on both.
+type OnBackend = fn(Fidelity, Backend) -> Result<Report>;
+
+/// The cases `validate --backend gpu` runs: the fluid cases whose lattices the GPU back end
+/// has (no obstacles, no Zou–He edges).
+pub const ON_ANY_BACKEND: &[(&str, OnBackend)] = &[
+    ("poiseuille", poiseuille::run_on),
+    ("taylor-green", taylor_green::run_on),
+    ("les-channel", les::run_on),
+    ("cavity-re100", cavity::re100_on),
+    ("cavity-re1000", cavity::re1000_on),
+];
+
+/// Run a case by name on `backend` (on the GPU: one of [`ON_ANY_BACKEND`]).
+pub fn run_on(name: &str, fidelity: Fidelity, backend: Backend) -> Result<Report> {
+    if backend == Backend::Cpu {
+        return run(name, fidelity);
+    }
+    let (_, case) = ON_ANY_BACKEND
+        .iter()
+        .find(|(n, _)| *n == name)
+        .ok_or_else(|| {
+            let names: Vec<_> = ON_ANY_BACKEND.iter().map(|c| c.0).collect();
+            crate::Error::Other(format!(
+                "validation case `{name}` does not run on the {} back end (obstacles, Zou-He \
+                 edges or grains are not built there yet); cases that do: {}",
+                backend.name(),
+                names.join(", ")
+            ))
+        })?;
+    case(fidelity, backend)
 }
 
 /// Run a case by name.

@@ -202,6 +202,24 @@ fn bad_input_names_the_field_and_the_reason() {
         |t| t.replace("collision = \"mrt\"", "collision = \"trt\""),
         &["trt"],
     );
+    // The GPU back end: in a build without it, the rebuild that gives it; with it, this
+    // file's obstacle, which it does not have yet.
+    check_error(
+        |t| {
+            t.replace(
+                "collision = \"mrt\"",
+                "collision = \"mrt\"\nbackend = \"gpu\"",
+            )
+        },
+        &[
+            "lbm.backend",
+            if cfg!(feature = "gpu") {
+                "obstacles are not built on the GPU"
+            } else {
+                "--features gpu"
+            },
+        ],
+    );
 }
 
 /// `granflow shear` refuses a bad test before running any, naming the option and the reason,

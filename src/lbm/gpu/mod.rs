@@ -22,6 +22,7 @@ use std::cell::{Cell, Ref, RefCell};
 
 use wgpu::util::DeviceExt;
 
+use super::backend::Backend;
 use super::boundary::Neighbour;
 use super::collision::{Collider, CollisionModel};
 use super::d2q9::Q;
@@ -42,10 +43,6 @@ const BULK: u32 = u32::MAX;
 const SOLID: u32 = u32::MAX - 1;
 /// Link-code bit of a bounce-back link.
 const BOUNCE: u32 = 1 << 31;
-
-/// A population type the device can hold: `f32`, or `f64` with `SHADER_F64`.
-pub trait DeviceReal: Real + bytemuck::Pod {}
-impl<T: Real + bytemuck::Pod> DeviceReal for T {}
 
 /// A GPU: the adapter wgpu picked, its device and queue.
 pub struct Gpu {
@@ -100,6 +97,41 @@ impl Gpu {
     }
 }
 
+impl Gpu {
+    /// Copy bandwidth of the device (GB/s, read + write) between two buffers of `bytes`
+    /// each (at most its largest buffer); best of 5.
+    pub fn copy_bandwidth(&self, bytes: usize) -> f64 {
+        let limit = self.device.limits().max_buffer_size;
+        let size = (bytes as u64).clamp(1 << 20, limit) / 4 * 4;
+        let buffer = |usage| {
+            self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("copy bandwidth"),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let src = buffer(wgpu::BufferUsages::COPY_SRC);
+        let dst = buffer(wgpu::BufferUsages::COPY_DST);
+        let copy = || {
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            encoder.copy_buffer_to_buffer(&src, 0, &dst, 0, size);
+            self.queue.submit([encoder.finish()]);
+            self.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .expect("the GPU device was lost");
+        };
+        copy();
+        (0..5)
+            .map(|_| {
+                let t0 = std::time::Instant::now();
+                copy();
+                2.0 * size as f64 / t0.elapsed().as_secs_f64() / 1e9
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
 /// A lattice's populations on the device and the two pipelines (even, odd step) that advance
 /// them.
 pub struct GpuLattice {
@@ -118,7 +150,7 @@ impl GpuLattice {
     /// Upload `lattice` (populations, parity, walls) and build the kernel for `collider`.
     /// Fails with the reason for what the device path does not have (Zou–He edges, f64
     /// without `SHADER_F64`, a lattice larger than the adapter's buffers).
-    pub fn new<T: DeviceReal>(
+    pub fn new<T: Real>(
         gpu: &Gpu,
         lattice: &Lattice<T>,
         collider: &Collider<T>,
@@ -130,13 +162,7 @@ impl GpuLattice {
                 gpu.name
             ));
         }
-        if lattice.specials.iter().any(|s| s.zou_he.is_some()) {
-            return Err(
-                "Zou-He (velocity or pressure) edges are not built on the GPU back end yet: \
-                 use backend = \"cpu\""
-                    .into(),
-            );
-        }
+        Backend::Gpu.check(lattice.edges(), 0)?;
         let (nx, ny) = (lattice.nx, lattice.ny);
         let (pops, even) = lattice.state();
         let stride = pops.len() / Q;
@@ -324,7 +350,7 @@ impl GpuLattice {
     }
 
     /// Copy the device's populations and parity into `lattice` (built like the uploaded one).
-    pub fn download<T: DeviceReal>(&self, lattice: &mut Lattice<T>) {
+    pub fn download<T: Real>(&self, lattice: &mut Lattice<T>) {
         let size = self.f.size();
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("read back"),
@@ -346,7 +372,7 @@ impl GpuLattice {
     }
 
     /// Replace the device's populations and parity by `lattice`'s.
-    pub fn upload<T: DeviceReal>(&mut self, lattice: &Lattice<T>) {
+    pub fn upload<T: Real>(&mut self, lattice: &Lattice<T>) {
         let (pops, even) = lattice.state();
         self.queue
             .write_buffer(&self.f, 0, bytemuck::cast_slice(&pops));
@@ -363,15 +389,11 @@ pub struct GpuFluid<T> {
     stale: Cell<bool>,
 }
 
-impl<T: DeviceReal> GpuFluid<T> {
+impl<T: Real> GpuFluid<T> {
     /// Move `lbm` onto the GPU. Fails with the reason for what the device path does not have
     /// (see the module docs).
     pub fn new(gpu: &Gpu, lbm: Lbm<T>) -> std::result::Result<Self, String> {
-        if !lbm.obstacles.list.is_empty() {
-            return Err(
-                "obstacles are not built on the GPU back end yet: use backend = \"cpu\"".into(),
-            );
-        }
+        Backend::Gpu.check(lbm.lattice.edges(), lbm.obstacles.list.len())?;
         let device = GpuLattice::new(gpu, &lbm.lattice, &lbm.collider)?;
         Ok(GpuFluid {
             host: RefCell::new(lbm),
@@ -390,11 +412,14 @@ impl<T: DeviceReal> GpuFluid<T> {
     }
 }
 
-impl<T: DeviceReal> Fluid for GpuFluid<T> {
+impl<T: Real> Fluid for GpuFluid<T> {
     fn steps(&mut self, n: u64) {
         self.device.run(n);
         self.host.get_mut().steps += n;
         self.stale.set(true);
+    }
+    fn finish(&self) {
+        self.device.finish()
     }
     fn step_count(&self) -> u64 {
         self.host.borrow().steps

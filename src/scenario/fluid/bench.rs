@@ -5,7 +5,9 @@
 //! the same threads, a parallel copy of an array as large as the populations, so the fraction
 //! of the memory-bandwidth roofline is measured on the machine at hand. A D2Q9 step moves at
 //! least 9 populations in and out: 72 B/cell in f32, 144 B/cell in f64. Copy bandwidth counts
-//! read + write bytes (as STREAM does).
+//! read + write bytes (as STREAM does). On the GPU back end (`--backend gpu`) the same box
+//! steps on the device, timed from submission to completion, and the roofline is the device's
+//! own buffer-to-buffer copy of as many bytes.
 
 use std::time::Instant;
 
@@ -13,7 +15,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::exec::{median, on_threads};
-use crate::lbm::{CollisionModel, Edges, FluidModel, Lattice, Lbm, MrtRates, Obstacles, Real};
+use crate::lbm::{
+    Backend, CollisionModel, Edges, Fluid, FluidModel, Lattice, Lbm, MrtRates, Obstacles, Real,
+};
 use crate::units::Units;
 use crate::{Error, Result};
 
@@ -42,26 +46,43 @@ pub struct LbmBench {
     pub collision: String,
     /// MLUPS of every repeat.
     pub samples: Vec<f64>,
+    /// `"cpu"` or `"gpu"`.
+    pub backend: String,
+    /// The GPU adapter (GPU back end only).
+    pub device: Option<String>,
 }
 
-fn time_lbm<T: Real>(
-    nx: usize,
-    ny: usize,
-    steps: u64,
-    mrt: bool,
-    repeats: usize,
-) -> Result<Vec<f64>> {
+/// What `granflow bench lbm` times: a periodic `nx × ny` box for `steps` steps per repeat.
+#[derive(Clone, Copy, Debug)]
+pub struct LbmCase {
+    /// Cells along x.
+    pub nx: usize,
+    /// Cells along y.
+    pub ny: usize,
+    /// Steps per repeat.
+    pub steps: u64,
+    /// f64 populations (else f32).
+    pub f64: bool,
+    /// MRT collision (else BGK).
+    pub mrt: bool,
+    /// Where the lattice steps.
+    pub backend: Backend,
+}
+
+/// The benchmark's fluid: a decaying shear wave in a periodic box.
+fn shear_wave<T: Real>(case: &LbmCase) -> Result<Lbm<T>> {
+    let (nx, ny) = (case.nx, case.ny);
     let mut lat =
         Lattice::<T>::new(nx, ny, Edges::periodic(), vec![false; nx * ny]).map_err(Error::Other)?;
     let k = 2.0 * std::f64::consts::PI / ny as f64;
     lat.fill(|_, y| (1.0, 0.05 * (k * (y as f64 + 0.5)).sin(), 0.0));
     let tau = 0.6;
-    let model = if mrt {
+    let model = if case.mrt {
         CollisionModel::Mrt(MrtRates::standard(tau))
     } else {
         CollisionModel::Bgk
     };
-    let mut lbm = Lbm::new(
+    Ok(Lbm::new(
         lat,
         FluidModel {
             collision: model,
@@ -70,23 +91,65 @@ fn time_lbm<T: Real>(
         },
         Obstacles::default(),
         Units::lattice(tau),
-    );
-    lbm.step();
-    lbm.step();
+    ))
+}
+
+/// MLUPS of each repeat of `step(steps)` (which returns when the steps are done), after two
+/// warm-up steps; the run must stay stable.
+fn time_steps(
+    case: &LbmCase,
+    repeats: usize,
+    fluid: &mut dyn Fluid,
+    run: impl Fn(&mut dyn Fluid, u64),
+) -> Result<Vec<f64>> {
+    run(fluid, 2);
     let mut out = Vec::new();
     for _ in 0..repeats {
         let t0 = Instant::now();
-        for _ in 0..steps {
-            lbm.step();
-        }
-        out.push((nx * ny) as f64 * steps as f64 / t0.elapsed().as_secs_f64() / 1e6);
+        run(fluid, case.steps);
+        let cells = (case.nx * case.ny) as f64;
+        out.push(cells * case.steps as f64 / t0.elapsed().as_secs_f64() / 1e6);
     }
-    if let Some((c, why)) = lbm.find_instability(0.5) {
-        return Err(Error::Other(format!(
-            "benchmark went unstable at cell {c}: {why}"
-        )));
-    }
+    fluid.check_stable(0.5)?;
     Ok(out)
+}
+
+/// MLUPS of each repeat on the CPU, and the copy bandwidth beside it.
+fn time_cpu<T: Real>(case: &LbmCase, repeats: usize) -> Result<(Vec<f64>, f64, Option<String>)> {
+    let copy = copy_bandwidth(9 * case.nx * case.ny * std::mem::size_of::<T>());
+    let mut lbm = shear_wave::<T>(case)?;
+    let samples = time_steps(case, repeats, &mut lbm, |f, n| f.steps(n))?;
+    Ok((samples, copy, None))
+}
+
+/// MLUPS of each repeat on the GPU, the device's copy bandwidth and its name.
+#[cfg(feature = "gpu")]
+fn time_gpu(case: &LbmCase, repeats: usize) -> Result<(Vec<f64>, f64, Option<String>)> {
+    use crate::lbm::gpu::{Gpu, GpuFluid};
+    fn on<T: Real>(
+        gpu: Gpu,
+        case: &LbmCase,
+        repeats: usize,
+    ) -> Result<(Vec<f64>, f64, Option<String>)> {
+        let copy = gpu.copy_bandwidth(9 * case.nx * case.ny * std::mem::size_of::<T>());
+        let mut fluid = GpuFluid::new(&gpu, shear_wave::<T>(case)?).map_err(Error::Other)?;
+        let samples = time_steps(case, repeats, &mut fluid, |f, n| {
+            f.steps(n);
+            f.finish();
+        })?;
+        Ok((samples, copy, Some(gpu.name)))
+    }
+    let gpu = Gpu::new().map_err(Error::Other)?;
+    if case.f64 {
+        on::<f64>(gpu, case, repeats)
+    } else {
+        on::<f32>(gpu, case, repeats)
+    }
+}
+
+#[cfg(not(feature = "gpu"))]
+fn time_gpu(_: &LbmCase, _: usize) -> Result<(Vec<f64>, f64, Option<String>)> {
+    Err(Error::Other(crate::lbm::backend::NOT_BUILT.into()))
 }
 
 /// Parallel copy bandwidth (GB/s, read + write) of two arrays of `bytes` each; best of 5.
@@ -108,32 +171,23 @@ pub fn copy_bandwidth(bytes: usize) -> f64 {
     best
 }
 
-/// Run the LBM benchmark on `threads` threads (0: rayon's default).
-pub fn lbm(
-    nx: usize,
-    ny: usize,
-    steps: u64,
-    f64_: bool,
-    mrt: bool,
-    threads: usize,
-    repeats: usize,
-) -> Result<LbmBench> {
+/// Run the LBM benchmark of `case` on `threads` threads (0: rayon's default).
+pub fn lbm(case: LbmCase, threads: usize, repeats: usize) -> Result<LbmBench> {
+    let (nx, ny, steps) = (case.nx, case.ny, case.steps);
     if nx < 3 || ny < 3 || steps == 0 || repeats == 0 {
         return Err(Error::Other(
             "bench lbm: need nx, ny ≥ 3 and steps, repeats ≥ 1".into(),
         ));
     }
     on_threads(threads, || {
-        let elem = if f64_ { 8 } else { 4 };
-        let copy_gb_s = copy_bandwidth(9 * nx * ny * elem);
-        let mut samples = if f64_ {
-            time_lbm::<f64>(nx, ny, steps, mrt, repeats)?
-        } else {
-            time_lbm::<f32>(nx, ny, steps, mrt, repeats)?
+        let (mut samples, copy_gb_s, device) = match (case.backend, case.f64) {
+            (Backend::Cpu, false) => time_cpu::<f32>(&case, repeats)?,
+            (Backend::Cpu, true) => time_cpu::<f64>(&case, repeats)?,
+            (Backend::Gpu, _) => time_gpu(&case, repeats)?,
         };
         let all = samples.clone();
         let mlups = median(&mut samples);
-        let bytes_per_cell = 18 * elem;
+        let bytes_per_cell = 18 * if case.f64 { 8 } else { 4 };
         Ok(LbmBench {
             mlups,
             bytes_per_cell,
@@ -143,9 +197,11 @@ pub fn lbm(
             ny,
             steps,
             threads: rayon::current_num_threads(),
-            precision: if f64_ { "f64" } else { "f32" }.into(),
-            collision: if mrt { "mrt" } else { "bgk" }.into(),
+            precision: if case.f64 { "f64" } else { "f32" }.into(),
+            collision: if case.mrt { "mrt" } else { "bgk" }.into(),
             samples: all,
+            backend: case.backend.name().into(),
+            device,
         })
     })
 }

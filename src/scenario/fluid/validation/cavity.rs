@@ -11,7 +11,7 @@
 //! Gates (the issue; docs/validation.md): max |Δu|, |Δv| ≤ 0.02 U on the centre lines, and the vortex
 //! centre within 0.02 L of Ghia's.
 
-use crate::lbm::{Lbm, Macroscopic};
+use crate::lbm::{Backend, Macroscopic};
 use crate::report::{Check, Fidelity, Plot, Report, Series};
 use crate::scenario::fluid::Scenario;
 use crate::scenario::ScenarioFile;
@@ -167,8 +167,9 @@ impl Field {
 }
 
 /// Run the scenario at `cells`² until steady (Δt ∝ Δx keeps the lattice lid speed).
-fn solve(text: &str, cells: usize) -> Result<Field> {
+fn solve(text: &str, cells: usize, backend: Backend) -> Result<Field> {
     let mut sc = Scenario::from_toml(text)?;
+    sc.lbm.backend = backend;
     let l = sc.domain.size[0];
     let dx = l / cells as f64;
     if let Some(dt) = sc.time.dt.as_mut() {
@@ -176,22 +177,18 @@ fn solve(text: &str, cells: usize) -> Result<Field> {
     }
     sc.domain.dx = dx;
     let d = sc.derive()?;
-    let mut lbm = sc.build_typed::<f64>(&d)?;
+    let mut lbm = sc.build_f64(&d)?;
     let n = d.cells[0];
     let u_lid = d.u_lattice;
     let transit = (n as f64 / u_lid).round() as u64;
     let mut m = Macroscopic::default();
     let mut prev = (vec![0.0; n * n], vec![0.0; n * n]);
     let mut residual = f64::INFINITY;
-    while lbm.steps < d.steps {
-        let chunk = transit.min(d.steps - lbm.steps);
-        advance(&mut lbm, chunk);
-        lbm.macroscopic_into(&mut m);
-        if let Some((c, why)) = lbm.find_instability(0.5) {
-            return Err(crate::Error::Other(format!(
-                "cavity: unstable at cell {c}: {why}"
-            )));
-        }
+    while lbm.step_count() < d.steps {
+        let chunk = transit.min(d.steps - lbm.step_count());
+        lbm.steps(chunk);
+        lbm.macroscopic(&mut m);
+        lbm.check_stable(0.5)?;
         residual = max_change(&m.ux, &prev.0).max(max_change(&m.uy, &prev.1)) / u_lid;
         prev = (m.ux.clone(), m.uy.clone());
         if residual < STEADY_TOL {
@@ -203,15 +200,9 @@ fn solve(text: &str, cells: usize) -> Result<Field> {
         n,
         u: scale(&m.ux),
         v: scale(&m.uy),
-        steps: lbm.steps,
+        steps: lbm.step_count(),
         residual,
     })
-}
-
-fn advance(lbm: &mut Lbm<f64>, steps: u64) {
-    for _ in 0..steps {
-        lbm.step();
-    }
 }
 
 fn max_change(a: &[f64], b: &[f64]) -> f64 {
@@ -320,9 +311,15 @@ fn cells(f: Fidelity) -> usize {
 
 /// Re 100 (BGK).
 pub fn run_re100(f: Fidelity) -> Result<Report> {
+    re100_on(f, Backend::Cpu)
+}
+
+/// Re 100 on `backend`.
+pub fn re100_on(f: Fidelity, backend: Backend) -> Result<Report> {
     let field = solve(
         include_str!("../../../../models/lbm/cavity_re100.toml"),
         cells(f),
+        backend,
     )?;
     Ok(Report {
         checks: compare("cavity-re100", &field, &GHIA_100),
@@ -332,9 +329,15 @@ pub fn run_re100(f: Fidelity) -> Result<Report> {
 
 /// Re 1000 (MRT).
 pub fn run_re1000(f: Fidelity) -> Result<Report> {
+    re1000_on(f, Backend::Cpu)
+}
+
+/// Re 1000 on `backend`.
+pub fn re1000_on(f: Fidelity, backend: Backend) -> Result<Report> {
     let field = solve(
         include_str!("../../../../models/lbm/cavity_re1000.toml"),
         cells(f),
+        backend,
     )?;
     Ok(Report {
         checks: compare("cavity-re1000", &field, &GHIA_1000),

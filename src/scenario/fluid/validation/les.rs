@@ -13,6 +13,7 @@
 //! error is the lattice's: the O(Δx²) bounce-back slip (≈ (3 − 16Λ)/(3H²) of u_max for
 //! BGK, Λ = (τ* − ½)², 7e-4 at H = 32) plus the O(Δx²) bulk error of the non-polynomial profile.
 
+use crate::lbm::Backend;
 use crate::report::{Check, Fidelity, Plot, Report, Series};
 use crate::scenario::fluid::Scenario;
 use crate::scenario::ScenarioFile;
@@ -92,12 +93,10 @@ fn solve(base: &Scenario, cells: usize) -> Result<Outcome> {
         * scale;
     sc.lbm.smagorinsky = Some(c);
     let d = sc.derive()?;
-    let mut lbm = sc.build_typed::<f64>(&d)?;
-    for _ in 0..d.steps {
-        lbm.step();
-    }
+    let mut lbm = sc.build_f64(&d)?;
+    lbm.steps(d.steps);
     let ny = d.cells[1];
-    let u: Vec<f64> = (0..ny).map(|y| lbm.cell(y * NX + 1).1).collect();
+    let u: Vec<f64> = (0..ny).map(|y| lbm.cell_state(y * NX + 1).1).collect();
     let model = MixingChannel {
         nu: d.nu_lattice,
         a: c * c / 2f64.sqrt(),
@@ -110,7 +109,13 @@ fn solve(base: &Scenario, cells: usize) -> Result<Outcome> {
 
 /// Run the case.
 pub fn run(f: Fidelity) -> Result<Report> {
-    let base = Scenario::from_toml(SCENARIO)?;
+    run_on(f, Backend::Cpu)
+}
+
+/// Run the case on `backend`.
+pub fn run_on(f: Fidelity, backend: Backend) -> Result<Report> {
+    let mut base = Scenario::from_toml(SCENARIO)?;
+    base.lbm.backend = backend;
     let cells: &[usize] = match f {
         Fidelity::Test => &[32, 64],
         Fidelity::Full => &[32, 64, 128],

@@ -16,6 +16,7 @@
 //!   δ = g(16Λ − 3)/(24ν), δ/u_max = (16Λ − 3)/(3H²) in lattice units; MRT with
 //!   Λ = 3/16 has none, so the two profiles differ by exactly δ.
 
+use crate::lbm::Backend;
 use crate::report::{Check, Fidelity, Plot, Report, Series};
 use crate::scenario::fluid::{CollisionKind, MrtSpec, Scenario};
 use crate::scenario::ScenarioFile;
@@ -91,13 +92,11 @@ fn solve(base: &Scenario, cells: usize, tau: f64, collision: Collision) -> Resul
         Collision::Mrt(rates) => (CollisionKind::Mrt, rates),
     };
     let d = sc.derive()?;
-    let mut lbm = sc.build_typed::<f64>(&d)?;
-    for _ in 0..d.steps {
-        lbm.step();
-    }
+    let mut lbm = sc.build_f64(&d)?;
+    lbm.steps(d.steps);
     let [nx, ny] = d.cells;
     let (g, nu, hl) = (d.force_lattice[0], d.nu_lattice, ny as f64);
-    let u: Vec<f64> = (0..ny).map(|y| lbm.cell(y * nx + 1).1).collect();
+    let u: Vec<f64> = (0..ny).map(|y| lbm.cell_state(y * nx + 1).1).collect();
     let exact = (0..ny)
         .map(|y| {
             let yc = y as f64 + 0.5;
@@ -105,7 +104,7 @@ fn solve(base: &Scenario, cells: usize, tau: f64, collision: Collision) -> Resul
         })
         .collect();
     let speed = (0..nx * ny).map(|c| {
-        let (_, ux, uy) = lbm.cell(c);
+        let (_, ux, uy) = lbm.cell_state(c);
         ux.hypot(uy)
     });
     let mach = speed.fold(0.0, f64::max) / CS2.sqrt();
@@ -130,7 +129,13 @@ pub(super) fn fitted_order(cells: &[usize], errors: &[f64]) -> f64 {
 
 /// Run the case.
 pub fn run(f: Fidelity) -> Result<Report> {
-    let base = Scenario::from_toml(SCENARIO)?;
+    run_on(f, Backend::Cpu)
+}
+
+/// Run the case on `backend`.
+pub fn run_on(f: Fidelity, backend: Backend) -> Result<Report> {
+    let mut base = Scenario::from_toml(SCENARIO)?;
+    base.lbm.backend = backend;
     let magic_tau = base.time.tau.unwrap_or(0.5 + 3f64.sqrt() / 4.0);
     let cells: &[usize] = match f {
         Fidelity::Test => &[16, 32, 64],

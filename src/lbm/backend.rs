@@ -1,0 +1,84 @@
+//! Where a fluid steps: on the CPU (rayon) or on a GPU (wgpu, feature `gpu`).
+
+use super::boundary::Edges;
+use super::real::Real;
+use super::solver::{Fluid, Lbm};
+
+/// The back end a fluid steps on.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Deserialize,
+    serde::Serialize,
+    schemars::JsonSchema,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Backend {
+    /// The CPU, on rayon's threads.
+    #[default]
+    Cpu,
+    /// A GPU through wgpu (Vulkan, Metal or DX12); needs a build with `--features gpu`.
+    Gpu,
+}
+
+impl Backend {
+    /// `"cpu"` or `"gpu"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Cpu => "cpu",
+            Backend::Gpu => "gpu",
+        }
+    }
+
+    /// Can this back end run a fluid with these edges and `obstacles` obstacles? The GPU
+    /// back end must be built into this binary and has no Zou–He edges or obstacles yet.
+    /// (Whether a device is found, and has what the precision needs, shows when it is built.)
+    pub fn check(self, edges: &Edges, obstacles: usize) -> Result<(), String> {
+        if self == Backend::Cpu {
+            return Ok(());
+        }
+        if !cfg!(feature = "gpu") {
+            return Err(NOT_BUILT.into());
+        }
+        if obstacles > 0 {
+            return Err(
+                "obstacles are not built on the GPU back end yet: use backend = \"cpu\"".into(),
+            );
+        }
+        if [&edges.left, &edges.right, &edges.bottom, &edges.top]
+            .iter()
+            .any(|e| e.is_zou_he())
+        {
+            return Err(
+                "Zou-He (velocity or pressure) edges are not built on the GPU back end \
+                 yet: use backend = \"cpu\""
+                    .into(),
+            );
+        }
+        Ok(())
+    }
+
+    /// `lbm` as a fluid on this back end. Fails with the reason when the GPU back end is not
+    /// built into this binary, finds no adapter, or lacks something `lbm` uses.
+    pub fn fluid<T: Real>(self, lbm: Lbm<T>) -> Result<Box<dyn Fluid>, String> {
+        match self {
+            Backend::Cpu => Ok(Box::new(lbm)),
+            #[cfg(feature = "gpu")]
+            Backend::Gpu => {
+                let gpu = super::gpu::Gpu::new()?;
+                Ok(Box::new(super::gpu::GpuFluid::new(&gpu, lbm)?))
+            }
+            #[cfg(not(feature = "gpu"))]
+            Backend::Gpu => Err(NOT_BUILT.into()),
+        }
+    }
+}
+
+/// Why `backend = "gpu"` fails in a build without the feature.
+pub const NOT_BUILT: &str = "this granflow was built without the GPU back end: rebuild with \
+     `cargo build --release --features gpu` (it needs a Vulkan, Metal or DX12 driver), or use \
+     backend = \"cpu\"";

@@ -35,31 +35,19 @@ impl Backend {
     }
 
     /// Can this back end run a fluid with these edges and `obstacles` obstacles? The GPU
-    /// back end must be built into this binary and has no Zou–He edges or obstacles yet.
+    /// back end must be built into this binary and has what `lbm::gpu::supports` says.
     /// (Whether a device is found, and has what the precision needs, shows when it is built.)
     pub fn check(self, edges: &Edges, obstacles: usize) -> Result<(), String> {
-        if self == Backend::Cpu {
-            return Ok(());
+        match self {
+            Backend::Cpu => Ok(()),
+            #[cfg(feature = "gpu")]
+            Backend::Gpu => super::gpu::supports(edges, obstacles),
+            #[cfg(not(feature = "gpu"))]
+            Backend::Gpu => {
+                let _ = (edges, obstacles);
+                Err(NOT_BUILT.into())
+            }
         }
-        if !cfg!(feature = "gpu") {
-            return Err(NOT_BUILT.into());
-        }
-        if obstacles > 0 {
-            return Err(
-                "obstacles are not built on the GPU back end yet: use backend = \"cpu\"".into(),
-            );
-        }
-        if [&edges.left, &edges.right, &edges.bottom, &edges.top]
-            .iter()
-            .any(|e| e.is_zou_he())
-        {
-            return Err(
-                "Zou-He (velocity or pressure) edges are not built on the GPU back end \
-                 yet: use backend = \"cpu\""
-                    .into(),
-            );
-        }
-        Ok(())
     }
 
     /// `lbm` as a fluid on this back end. Fails with the reason when the GPU back end is not
@@ -79,6 +67,7 @@ impl Backend {
 }
 
 /// Why `backend = "gpu"` fails in a build without the feature.
+#[cfg(not(feature = "gpu"))]
 pub const NOT_BUILT: &str = "this granflow was built without the GPU back end: rebuild with \
      `cargo build --release --features gpu` (it needs a Vulkan, Metal or DX12 driver), or use \
      backend = \"cpu\"";

@@ -22,8 +22,7 @@ use std::cell::{Cell, Ref, RefCell};
 
 use wgpu::util::DeviceExt;
 
-use super::backend::Backend;
-use super::boundary::Neighbour;
+use super::boundary::{Edges, Neighbour};
 use super::collision::{Collider, CollisionModel};
 use super::d2q9::Q;
 use super::lattice::Lattice;
@@ -43,6 +42,27 @@ const BULK: u32 = u32::MAX;
 const SOLID: u32 = u32::MAX - 1;
 /// Link-code bit of a bounce-back link.
 const BOUNCE: u32 = 1 << 31;
+
+/// Does the GPU back end have a fluid with these edges and `obstacles` obstacles? Not yet:
+/// Zou–He edges and obstacles (the reason says so, and what to use instead).
+pub fn supports(edges: &Edges, obstacles: usize) -> std::result::Result<(), String> {
+    if obstacles > 0 {
+        return Err(
+            "obstacles are not built on the GPU back end yet: use backend = \"cpu\"".into(),
+        );
+    }
+    if [&edges.left, &edges.right, &edges.bottom, &edges.top]
+        .iter()
+        .any(|e| e.is_zou_he())
+    {
+        return Err(
+            "Zou-He (velocity or pressure) edges are not built on the GPU back end \
+             yet: use backend = \"cpu\""
+                .into(),
+        );
+    }
+    Ok(())
+}
 
 /// A GPU: the adapter wgpu picked, its device and queue.
 pub struct Gpu {
@@ -162,7 +182,7 @@ impl GpuLattice {
                 gpu.name
             ));
         }
-        Backend::Gpu.check(lattice.edges(), 0)?;
+        supports(lattice.edges(), 0)?;
         let (nx, ny) = (lattice.nx, lattice.ny);
         let (pops, even) = lattice.state();
         let stride = pops.len() / Q;
@@ -393,7 +413,7 @@ impl<T: Real> GpuFluid<T> {
     /// Move `lbm` onto the GPU. Fails with the reason for what the device path does not have
     /// (see the module docs).
     pub fn new(gpu: &Gpu, lbm: Lbm<T>) -> std::result::Result<Self, String> {
-        Backend::Gpu.check(lbm.lattice.edges(), lbm.obstacles.list.len())?;
+        supports(lbm.lattice.edges(), lbm.obstacles.list.len())?;
         let device = GpuLattice::new(gpu, &lbm.lattice, &lbm.collider)?;
         Ok(GpuFluid {
             host: RefCell::new(lbm),

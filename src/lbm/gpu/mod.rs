@@ -115,9 +115,7 @@ impl Gpu {
             f64,
         })
     }
-}
 
-impl Gpu {
     /// Copy bandwidth of the device (GB/s, read + write) between two buffers of `bytes`
     /// each (at most its largest buffer); best of 5.
     pub fn copy_bandwidth(&self, bytes: usize) -> f64 {

@@ -34,17 +34,17 @@ impl Backend {
         }
     }
 
-    /// Can this back end run a fluid with these edges and `obstacles` obstacles? The GPU
-    /// back end must be built into this binary and has what `lbm::gpu::supports` says.
+    /// Can this back end run a fluid with these edges? The GPU back end must be built into
+    /// this binary and has what `lbm::gpu::supports` says.
     /// (Whether a device is found, and has what the precision needs, shows when it is built.)
-    pub fn check(self, edges: &Edges, obstacles: usize) -> Result<(), String> {
+    pub fn check(self, edges: &Edges) -> Result<(), String> {
         match self {
             Backend::Cpu => Ok(()),
             #[cfg(feature = "gpu")]
-            Backend::Gpu => super::gpu::supports(edges, obstacles),
+            Backend::Gpu => super::gpu::supports(edges),
             #[cfg(not(feature = "gpu"))]
             Backend::Gpu => {
-                let _ = (edges, obstacles);
+                let _ = edges;
                 Err(NOT_BUILT.into())
             }
         }

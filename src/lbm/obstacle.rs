@@ -145,15 +145,15 @@ pub struct Obstacle {
 
 /// A fluid–solid link.
 #[derive(Clone, Debug)]
-struct Link {
+pub(crate) struct Link {
     /// Fluid node x_f.
-    cell: u32,
+    pub cell: u32,
     /// Direction into the solid.
-    dir: u8,
+    pub dir: u8,
     /// Owning obstacle.
     owner: u16,
     /// Wall distance fraction.
-    q: f64,
+    pub q: f64,
     /// x_f − e_i when it is a fluid node.
     behind: Option<u32>,
     /// Torque arm x_w − x_c.
@@ -170,6 +170,8 @@ pub struct Obstacles {
     pub force: Vec<[f64; 2]>,
     /// Torque on each obstacle in the last step (lattice units).
     pub torque: Vec<f64>,
+    /// Scratch: the momentum each link exchanged in the last step.
+    exchanged: Vec<f64>,
 }
 
 impl Obstacles {
@@ -258,19 +260,15 @@ impl Obstacles {
     /// After a step of parity `was_even`: apply interpolated bounce-back on interpolated links
     /// and record force and torque by momentum exchange.
     pub fn after_step<T: Real>(&mut self, lat: &mut Lattice<T>, was_even: bool) {
-        for f in &mut self.force {
-            *f = [0.0; 2];
-        }
-        for t in &mut self.torque {
-            *t = 0.0;
-        }
-        for link in &self.links {
+        let mut exchanged = std::mem::take(&mut self.exchanged);
+        exchanged.clear();
+        exchanged.extend(self.links.iter().map(|link| {
             let (c, i) = (link.cell as usize, link.dir as usize);
             let o = OPP[i];
             // f_i*(x_f): after either parity it sits in A[x_f][ī].
             let out = lat.slot(o, c);
-            let back = match link.behind {
-                Some(k) if self.list[link.owner as usize].interpolated => {
+            let back = match self.interpolated_behind(link) {
+                Some(k) => {
                     let k = k as usize;
                     let (in_behind, out_rev) = if was_even {
                         (lat.slot(o, k), lat.slot(i, c))
@@ -282,15 +280,44 @@ impl Obstacles {
                     lat.set_slot(o, c, v);
                     v
                 }
-                _ => out,
+                None => out,
             };
-            let m = (out + back).f64();
+            (out + back).f64()
+        }));
+        self.set_loads(&exchanged);
+        self.exchanged = exchanged;
+    }
+
+    /// Force and torque from the momentum `exchanged[l]` = f_i*(x_f) + f_ī(x_f) across each
+    /// link l in the last step: F = Σ m e_i, T = Σ (x_w − x_c) × m e_i, summed in link order.
+    pub(crate) fn set_loads(&mut self, exchanged: &[f64]) {
+        for f in &mut self.force {
+            *f = [0.0; 2];
+        }
+        for t in &mut self.torque {
+            *t = 0.0;
+        }
+        for (link, &m) in self.links.iter().zip(exchanged) {
+            let i = link.dir as usize;
             let df = [m * CX[i] as f64, m * CY[i] as f64];
             let k = link.owner as usize;
             self.force[k][0] += df[0];
             self.force[k][1] += df[1];
             self.torque[k] += link.arm[0] * df[1] - link.arm[1] * df[0];
         }
+    }
+
+    /// The fluid node behind `link` (x_f − e_i) when the link is interpolated (Yu 2003) and
+    /// that node is fluid; `None`: half-way bounce-back.
+    pub(crate) fn interpolated_behind(&self, link: &Link) -> Option<u32> {
+        link.behind
+            .filter(|_| self.list[link.owner as usize].interpolated)
+    }
+
+    /// The fluid–solid links.
+    #[cfg(feature = "gpu")]
+    pub(crate) fn links(&self) -> &[Link] {
+        &self.links
     }
 
     /// Number of fluid–solid links.

@@ -202,19 +202,27 @@ fn bad_input_names_the_field_and_the_reason() {
         |t| t.replace("collision = \"mrt\"", "collision = \"trt\""),
         &["trt"],
     );
-    // The GPU back end: in a build without it, the rebuild that gives it; with it, this
-    // file's obstacle, which it does not have yet.
+    // The GPU back end: in a build without it, the rebuild that gives it; with it, Zou–He
+    // edges, which it does not have yet.
     check_error(
         |t| {
             t.replace(
                 "collision = \"mrt\"",
                 "collision = \"mrt\"\nbackend = \"gpu\"",
             )
+            .replace(
+                "left = { type = \"periodic\" }",
+                "left = { type = \"pressure\", pressure = 1.0 }",
+            )
+            .replace(
+                "right = { type = \"periodic\" }",
+                "right = { type = \"pressure\", pressure = 0.0 }",
+            )
         },
         &[
             "lbm.backend",
             if cfg!(feature = "gpu") {
-                "obstacles are not built on the GPU"
+                "Zou-He (velocity or pressure) edges are not built on the GPU"
             } else {
                 "--features gpu"
             },

@@ -15,8 +15,11 @@
 //! when something is observed (a frame, a probe, a check, a checkpoint).
 //!
 //! Built: BGK and MRT, Smagorinsky LES, Guo forcing, periodic edges, half-way bounce-back
-//! walls at rest or moving, in f32, and in f64 where the adapter offers `SHADER_F64`. Refused
-//! with the reason (run them with `backend = "cpu"`): Zou–He edges and obstacles.
+//! walls at rest or moving, obstacles (half-way or Yu's interpolated bounce-back: a second
+//! kernel over the links after each step, which also stores the momentum each link exchanged;
+//! the loads are summed on the host in link order when observed, as the CPU sums them), in
+//! f32, and in f64 where the adapter offers `SHADER_F64`. Refused with the reason (run them
+//! with `backend = "cpu"`): Zou–He edges.
 
 use std::cell::{Cell, Ref, RefCell};
 
@@ -26,6 +29,7 @@ use super::boundary::{Edges, Neighbour};
 use super::collision::{Collider, CollisionModel};
 use super::d2q9::Q;
 use super::lattice::Lattice;
+use super::obstacle::Obstacles;
 use super::real::Real;
 use super::solver::{Fluid, Lbm, LbmState, Macroscopic};
 use crate::units::Units;
@@ -43,14 +47,9 @@ const SOLID: u32 = u32::MAX - 1;
 /// Link-code bit of a bounce-back link.
 const BOUNCE: u32 = 1 << 31;
 
-/// Does the GPU back end have a fluid with these edges and `obstacles` obstacles? Not yet:
-/// Zou–He edges and obstacles (the reason says so, and what to use instead).
-pub fn supports(edges: &Edges, obstacles: usize) -> std::result::Result<(), String> {
-    if obstacles > 0 {
-        return Err(
-            "obstacles are not built on the GPU back end yet: use backend = \"cpu\"".into(),
-        );
-    }
+/// Does the GPU back end have a fluid with these edges? Not yet: Zou–He edges (the reason
+/// says so, and what to use instead).
+pub fn supports(edges: &Edges) -> std::result::Result<(), String> {
     if [&edges.left, &edges.right, &edges.bottom, &edges.top]
         .iter()
         .any(|e| e.is_zou_he())
@@ -150,13 +149,18 @@ impl Gpu {
     }
 }
 
-/// A lattice's populations on the device and the two pipelines (even, odd step) that advance
-/// them.
+/// A lattice's populations on the device, its obstacle links, and the pipelines that advance
+/// them: the step and the obstacles' after-step, each for an even and an odd step.
 pub struct GpuLattice {
     device: wgpu::Device,
     queue: wgpu::Queue,
     /// Pipelines of the odd and the even step.
     pipelines: [wgpu::ComputePipeline; 2],
+    /// Obstacle after-step pipelines after an odd and after an even step.
+    after: [wgpu::ComputePipeline; 2],
+    /// Number of obstacle links, and the momentum each exchanged in the last step.
+    links: u32,
+    exchanged: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     f: wgpu::Buffer,
     groups: [u32; 2],
@@ -165,13 +169,15 @@ pub struct GpuLattice {
 }
 
 impl GpuLattice {
-    /// Upload `lattice` (populations, parity, walls) and build the kernel for `collider`.
-    /// Fails with the reason for what the device path does not have (Zou–He edges, f64
-    /// without `SHADER_F64`, a lattice larger than the adapter's buffers).
+    /// Upload `lattice` (populations, parity, walls) with the links of its `obstacles` and
+    /// build the kernels for `collider`. Fails with the reason for what the device path does
+    /// not have (Zou–He edges, f64 without `SHADER_F64`, a lattice larger than the adapter's
+    /// buffers).
     pub fn new<T: Real>(
         gpu: &Gpu,
         lattice: &Lattice<T>,
         collider: &Collider<T>,
+        obstacles: &Obstacles,
     ) -> std::result::Result<Self, String> {
         if T::NAME == "f64" && !gpu.f64 {
             return Err(format!(
@@ -180,7 +186,7 @@ impl GpuLattice {
                 gpu.name
             ));
         }
-        supports(lattice.edges(), 0)?;
+        supports(lattice.edges())?;
         let (nx, ny) = (lattice.nx, lattice.ny);
         let (pops, even) = lattice.state();
         let stride = pops.len() / Q;
@@ -207,7 +213,7 @@ impl GpuLattice {
                 s => s,
             })
             .collect();
-        let mut links: Vec<u32> = lattice
+        let mut special_links: Vec<u32> = lattice
             .specials
             .iter()
             .flat_map(|s| {
@@ -219,8 +225,20 @@ impl GpuLattice {
             })
             .collect();
         // A binding may not be empty.
-        links.resize(links.len().max(Q), 0);
+        special_links.resize(special_links.len().max(Q), 0);
         let corr: Vec<T> = lattice.wall_corr.iter().flatten().copied().collect();
+        let mut solid_links: Vec<u32> = obstacles
+            .links()
+            .iter()
+            .flat_map(|l| {
+                let behind = obstacles.interpolated_behind(l).unwrap_or(u32::MAX);
+                [l.cell, u32::from(l.dir), behind]
+            })
+            .collect();
+        let mut link_q: Vec<T> = obstacles.links().iter().map(|l| T::c(l.q)).collect();
+        let links = link_q.len() as u32;
+        solid_links.resize(solid_links.len().max(3), 0);
+        link_q.resize(link_q.len().max(1), T::zero());
         let s = match collider.model {
             CollisionModel::Bgk => [0.0; 3],
             CollisionModel::Mrt(r) => [r.s_e, r.s_eps, r.s_q],
@@ -249,12 +267,16 @@ impl GpuLattice {
         let copy = wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let read = wgpu::BufferUsages::empty();
         let f = storage("populations", bytemuck::cast_slice(&pops), copy);
+        let exchanged = storage("exchanged", bytemuck::cast_slice(&link_q), copy);
         let buffers = [
             &f,
             &storage("kind", bytemuck::cast_slice(&kind), read),
-            &storage("links", bytemuck::cast_slice(&links), read),
+            &storage("links", bytemuck::cast_slice(&special_links), read),
             &storage("wall terms", bytemuck::cast_slice(&corr), read),
             &storage("collision", bytemuck::cast_slice(&coef), read),
+            &storage("obstacle links", bytemuck::cast_slice(&solid_links), read),
+            &storage("link q", bytemuck::cast_slice(&link_q), read),
+            &exchanged,
         ];
         let source = SOURCE.replacen(
             "alias real = f32;",
@@ -265,14 +287,14 @@ impl GpuLattice {
             label: Some("stream_collide.wgsl"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
-        // Binding 0 (the populations) is written, the others are read.
+        // Bindings 0 (the populations) and 7 (the exchanged momenta) are written.
         let layout_entries: Vec<wgpu::BindGroupLayoutEntry> = (0..buffers.len() as u32)
             .map(|binding| wgpu::BindGroupLayoutEntry {
                 binding,
                 visibility: wgpu::ShaderStages::COMPUTE,
                 ty: wgpu::BindingType::Buffer {
                     ty: wgpu::BufferBindingType::Storage {
-                        read_only: binding > 0,
+                        read_only: binding != 0 && binding != 7,
                     },
                     has_dynamic_offset: false,
                     min_binding_size: None,
@@ -290,7 +312,7 @@ impl GpuLattice {
             push_constant_ranges: &[],
         });
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
-        let pipeline = |even: bool| {
+        let pipeline = |entry: &str, even: bool| {
             let constants = [
                 ("NX", nx as f64),
                 ("NY", ny as f64),
@@ -302,12 +324,13 @@ impl GpuLattice {
                 ),
                 ("LES", flag(collider.smagorinsky.is_some())),
                 ("FORCE", flag(collider.force != [0.0, 0.0])),
+                ("LINKS", f64::from(links)),
             ];
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(if even { "even step" } else { "odd step" }),
+                label: Some(entry),
                 layout: Some(&layout),
                 module: &module,
-                entry_point: Some("stream_collide"),
+                entry_point: Some(entry),
                 compilation_options: wgpu::PipelineCompilationOptions {
                     constants: &constants,
                     zero_initialize_workgroup_memory: false,
@@ -315,7 +338,8 @@ impl GpuLattice {
                 cache: None,
             })
         };
-        let pipelines = [pipeline(false), pipeline(true)];
+        let pipelines = [false, true].map(|even| pipeline("stream_collide", even));
+        let after = [false, true].map(|even| pipeline("after_step", even));
         let entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
             .enumerate()
@@ -333,6 +357,9 @@ impl GpuLattice {
             device,
             queue: gpu.queue.clone(),
             pipelines,
+            after,
+            links,
+            exchanged,
             bind_group,
             f,
             groups: [(nx as u32).div_ceil(GROUP_X), ny as u32],
@@ -350,8 +377,13 @@ impl GpuLattice {
                 let mut pass = encoder.begin_compute_pass(&Default::default());
                 pass.set_bind_group(0, &self.bind_group, &[]);
                 for _ in 0..batch {
-                    pass.set_pipeline(&self.pipelines[usize::from(self.even)]);
+                    let parity = usize::from(self.even);
+                    pass.set_pipeline(&self.pipelines[parity]);
                     pass.dispatch_workgroups(self.groups[0], self.groups[1], 1);
+                    if self.links > 0 {
+                        pass.set_pipeline(&self.after[parity]);
+                        pass.dispatch_workgroups(self.links.div_ceil(GROUP_X), 1, 1);
+                    }
                     self.even = !self.even;
                 }
             }
@@ -367,9 +399,9 @@ impl GpuLattice {
             .expect("the GPU device was lost");
     }
 
-    /// Copy the device's populations and parity into `lattice` (built like the uploaded one).
-    pub fn download<T: Real>(&self, lattice: &mut Lattice<T>) {
-        let size = self.f.size();
+    /// The contents of `buffer`, read back.
+    fn read<T: Real>(&self, buffer: &wgpu::Buffer) -> Vec<T> {
+        let size = buffer.size();
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("read back"),
             size,
@@ -377,16 +409,27 @@ impl GpuLattice {
             mapped_at_creation: false,
         });
         let mut encoder = self.device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(&self.f, 0, &staging, 0, size);
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
         self.queue.submit([encoder.finish()]);
         let slice = staging.slice(..);
         slice.map_async(wgpu::MapMode::Read, |r| {
-            r.expect("mapping the GPU's populations for reading failed")
+            r.expect("mapping a GPU buffer for reading failed")
         });
         self.finish();
-        let pops: Vec<T> = bytemuck::cast_slice(&slice.get_mapped_range()).to_vec();
+        let values: Vec<T> = bytemuck::cast_slice(&slice.get_mapped_range()).to_vec();
         staging.unmap();
-        lattice.set_state(pops, self.even);
+        values
+    }
+
+    /// Copy the device's populations and parity into `lattice` (built like the uploaded one).
+    pub fn download<T: Real>(&self, lattice: &mut Lattice<T>) {
+        lattice.set_state(self.read(&self.f), self.even);
+    }
+
+    /// The momentum each obstacle link exchanged in the last step (link order).
+    pub fn exchanged<T: Real>(&self) -> Vec<f64> {
+        let m: Vec<T> = self.read(&self.exchanged);
+        m[..self.links as usize].iter().map(|v| v.f64()).collect()
     }
 
     /// Replace the device's populations and parity by `lattice`'s.
@@ -411,8 +454,7 @@ impl<T: Real> GpuFluid<T> {
     /// Move `lbm` onto the GPU. Fails with the reason for what the device path does not have
     /// (see the module docs).
     pub fn new(gpu: &Gpu, lbm: Lbm<T>) -> std::result::Result<Self, String> {
-        supports(lbm.lattice.edges(), lbm.obstacles.list.len())?;
-        let device = GpuLattice::new(gpu, &lbm.lattice, &lbm.collider)?;
+        let device = GpuLattice::new(gpu, &lbm.lattice, &lbm.collider, &lbm.obstacles)?;
         Ok(GpuFluid {
             host: RefCell::new(lbm),
             device,
@@ -420,10 +462,15 @@ impl<T: Real> GpuFluid<T> {
         })
     }
 
-    /// The host copy, brought up to date with the device.
+    /// The host copy, brought up to date with the device (populations and the last step's
+    /// obstacle loads).
     pub fn host(&self) -> Ref<'_, Lbm<T>> {
         if self.stale.get() {
-            self.device.download(&mut self.host.borrow_mut().lattice);
+            let host = &mut *self.host.borrow_mut();
+            self.device.download(&mut host.lattice);
+            if self.device.links > 0 {
+                host.obstacles.set_loads(&self.device.exchanged::<T>());
+            }
             self.stale.set(false);
         }
         self.host.borrow()
@@ -452,7 +499,8 @@ impl<T: Real> Fluid for GpuFluid<T> {
         self.host().cell(c)
     }
     fn obstacle_loads(&self) -> (Vec<[f64; 2]>, Vec<f64>) {
-        (Vec::new(), Vec::new())
+        let host = self.host();
+        (host.obstacles.force.clone(), host.obstacles.torque.clone())
     }
     fn total_mass(&self) -> f64 {
         self.host().lattice.total_mass()

@@ -16,7 +16,8 @@ alias real = f32;
 override NX: u32;
 override NY: u32;
 override STRIDE: u32;
-// Parity of the step this pipeline runs, and the collision variant.
+// Parity of the step this pipeline runs (`after_step`: of the step just run), and the
+// collision variant.
 override EVEN: bool;
 override MRT: bool;
 override LES: bool;
@@ -36,6 +37,16 @@ const BOUNCE: u32 = 0x80000000u;
 @group(0) @binding(3) var<storage, read> corr: array<real>;
 // ω = 1/τ, τ, 18 C², F_x, F_y, s_e, s_ε, s_q.
 @group(0) @binding(4) var<storage, read> coef: array<real>;
+// Obstacle links (`after_step`): per link the fluid node x_f, the direction e_i into the
+// solid and the node behind, x_f − e_i, where the link is interpolated (else NONE) …
+@group(0) @binding(5) var<storage, read> links_solid: array<u32>;
+// … its wall distance q …
+@group(0) @binding(6) var<storage, read> link_q: array<real>;
+// … and the momentum it exchanged in the last step, f_i*(x_f) + f_ī(x_f).
+@group(0) @binding(7) var<storage, read_write> exchanged: array<real>;
+// Number of obstacle links.
+override LINKS: u32;
+const NONE: u32 = 0xffffffffu;
 
 const CX = array<i32, 9>(0, 1, 0, -1, 0, 1, -1, -1, 1);
 const CY = array<i32, 9>(0, 0, 1, 0, -1, 1, 1, -1, -1);
@@ -254,4 +265,38 @@ fn stream_collide(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         }
     }
+}
+
+// After a step: Yu's interpolated bounce-back on interpolated obstacle links (Yu et al. 2003,
+// as `lbm::obstacle`), f_ī(x_f) = [(1 − q) f_ī^in(x_b) + q f_i*(x_f) + q f_ī*(x_f)]/(1 + q)
+// with x_b = x_f − e_i, and the momentum each link exchanged, for the loads. No two links
+// write a slot another link reads (one thread per link).
+@compute @workgroup_size(64, 1, 1)
+fn after_step(@builtin(global_invocation_id) id: vec3<u32>) {
+    let l = id.x;
+    if (l >= LINKS) {
+        return;
+    }
+    let c = links_solid[3u * l];
+    let i = links_solid[3u * l + 1u];
+    let k = links_solid[3u * l + 2u];
+    let o = OPP[i];
+    // f_i*(x_f): after either parity it sits in A[x_f][ī].
+    let out = f[o * STRIDE + c];
+    var back = out;
+    if (k != NONE) {
+        var in_behind: real;
+        var out_rev: real;
+        if (EVEN) {
+            in_behind = f[o * STRIDE + k];
+            out_rev = f[i * STRIDE + c];
+        } else {
+            in_behind = f[i * STRIDE + c];
+            out_rev = f[o * STRIDE + k];
+        }
+        let q = link_q[l];
+        back = ((1.0 - q) * in_behind + q * out + q * out_rev) / (1.0 + q);
+        f[o * STRIDE + c] = back;
+    }
+    exchanged[l] = out + back;
 }

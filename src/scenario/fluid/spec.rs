@@ -115,7 +115,7 @@ pub struct LbmSpec {
     /// `"f32"` or `"f64"`.
     pub precision: Precision,
     /// Where the lattice steps: `"cpu"` (the default) or `"gpu"` (a build with the `gpu`
-    /// feature; periodic edges and walls, no Zou–He edges or obstacles yet; f64 needs an
+    /// feature; periodic edges, walls and obstacles, no Zou–He edges yet; f64 needs an
     /// adapter with SHADER_F64).
     #[serde(default)]
     pub backend: crate::lbm::Backend,
@@ -499,7 +499,7 @@ impl Scenario {
         };
         self.lbm
             .backend
-            .check(&self.edges(&units, nx, ny), self.obstacles.len())
+            .check(&self.edges(&units, nx, ny))
             .map_err(|e| Error::config("lbm.backend", e))?;
         Ok(Derived {
             units,
@@ -671,21 +671,27 @@ impl Scenario {
     /// The solver in f64 whatever `lbm.precision` says (as the validation cases run), on the
     /// file's back end.
     pub fn build_f64(&self, d: &Derived) -> Result<Box<dyn crate::lbm::Fluid>> {
+        self.on_backend(self.build_typed::<f64>(d)?)
+    }
+
+    /// `lbm`, built from this file, moved onto the file's back end.
+    pub fn on_backend<T: crate::lbm::Real>(
+        &self,
+        lbm: crate::lbm::Lbm<T>,
+    ) -> Result<Box<dyn crate::lbm::Fluid>> {
         self.lbm
             .backend
-            .fluid(self.build_typed::<f64>(d)?)
+            .fluid(lbm)
             .map_err(|e| Error::config("lbm.backend", e))
     }
 
     /// Check, derive and build the solver in the scenario's precision.
     pub fn build(&self) -> Result<(Box<dyn crate::lbm::Fluid>, Derived)> {
         let d = self.derive()?;
-        let backend = self.lbm.backend;
         let fluid = match self.lbm.precision {
-            Precision::F32 => backend.fluid(self.build_typed::<f32>(&d)?),
-            Precision::F64 => backend.fluid(self.build_typed::<f64>(&d)?),
-        }
-        .map_err(|e| Error::config("lbm.backend", e))?;
+            Precision::F32 => self.on_backend(self.build_typed::<f32>(&d)?)?,
+            Precision::F64 => self.on_backend(self.build_typed::<f64>(&d)?)?,
+        };
         Ok((fluid, d))
     }
 

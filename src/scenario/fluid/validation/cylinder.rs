@@ -7,7 +7,7 @@
 //! [`Units::force_to_si`](crate::units::Units::force_to_si).
 
 use crate::analysis::spectrum::dominant_frequency;
-use crate::lbm::Lbm;
+use crate::lbm::{Backend, Fluid, Lbm};
 use crate::report::{Check, Fidelity, Plot, Report, Series, MAX_PLOT_POINTS};
 use crate::scenario::fluid::{Derived, EdgeSpec, ObstacleSpec, Scenario};
 use crate::scenario::ScenarioFile;
@@ -88,19 +88,16 @@ fn refine(scn: &mut Scenario, factor: f64) {
 
 /// Advance `n` steps (n ≥ 2) and return the obstacle force (lattice units) averaged over the
 /// last two steps, one even and one odd, which removes the AA pattern's step-parity wobble.
-fn advance(lbm: &mut Lbm<f64>, n: u64) -> [f64; 2] {
-    for _ in 0..n.saturating_sub(1) {
-        lbm.step();
-    }
-    let a = lbm.obstacles.force[0];
-    lbm.step();
-    let b = lbm.obstacles.force[0];
+fn advance(lbm: &mut dyn Fluid, n: u64) -> [f64; 2] {
+    lbm.steps(n.saturating_sub(1));
+    let a = lbm.obstacle_loads().0[0];
+    lbm.steps(1);
+    let b = lbm.obstacle_loads().0[0];
     [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]
 }
 
 /// Stop with [`Error::Unstable`] if the run blew up.
-fn stable(lbm: &Lbm<f64>) -> Result<()> {
-    use crate::lbm::Fluid;
+fn stable(lbm: &dyn Fluid) -> Result<()> {
     lbm.check_stable(0.5)
 }
 
@@ -399,7 +396,13 @@ struct ArrayDrag {
 
 /// Sangani–Acrivos periodic square array: F/(μU) within 3 % for Φ = 0.05, 0.1, 0.2, 0.4.
 pub fn run_array(fidelity: Fidelity) -> Result<Report> {
+    run_array_on(fidelity, Backend::Cpu)
+}
+
+/// The periodic cylinder array on `backend`.
+pub fn run_array_on(fidelity: Fidelity, backend: Backend) -> Result<Report> {
     let mut base = Scenario::from_toml(TOML_ARRAY)?;
+    base.lbm.backend = backend;
     if fidelity == Fidelity::Full {
         refine(&mut base, 2.0);
     }
@@ -476,19 +479,21 @@ fn array_drag(base: &Scenario, phi: f64, interpolate: bool) -> Result<ArrayDrag>
         *interpolated = interpolate;
     }
     let d = scn.derive()?;
-    let mut lbm = scn.build_typed::<f64>(&d)?;
+    let lbm = scn.build_typed::<f64>(&d)?;
     let n = lbm.lattice.len();
     let fluid: Vec<usize> = (0..n).filter(|&c| !lbm.lattice.is_solid(c)).collect();
-    let superficial = |lbm: &Lbm<f64>| fluid.iter().map(|&c| lbm.cell(c).1).sum::<f64>() / n as f64;
+    let mut lbm = scn.on_backend(lbm)?;
+    let superficial =
+        |lbm: &dyn Fluid| fluid.iter().map(|&c| lbm.cell_state(c).1).sum::<f64>() / n as f64;
     let every = 500;
     let mut u_last = 0.0;
     let mut steps = 0;
     let mut force = [0.0; 2];
     while steps < d.steps {
-        force = advance(&mut lbm, every);
+        force = advance(lbm.as_mut(), every);
         steps += every;
-        stable(&lbm)?;
-        let u = superficial(&lbm);
+        stable(lbm.as_ref())?;
+        let u = superficial(lbm.as_ref());
         let done = ((u - u_last) / u).abs() < 1e-6;
         u_last = u;
         if done {

@@ -94,14 +94,13 @@ fn shear_wave<T: Real>(case: &LbmCase) -> Result<Lbm<T>> {
     ))
 }
 
-/// MLUPS of each repeat of `step(steps)` (which returns when the steps are done), after two
-/// warm-up steps; the run must stay stable.
-fn time_steps(
-    case: &LbmCase,
-    repeats: usize,
-    fluid: &mut dyn Fluid,
-    run: impl Fn(&mut dyn Fluid, u64),
-) -> Result<Vec<f64>> {
+/// MLUPS of each repeat of `case.steps` steps on `fluid`, timed to their completion
+/// ([`Fluid::finish`]), after two warm-up steps; the run must stay stable.
+fn time_steps(case: &LbmCase, repeats: usize, fluid: &mut dyn Fluid) -> Result<Vec<f64>> {
+    let run = |fluid: &mut dyn Fluid, n| {
+        fluid.steps(n);
+        fluid.finish();
+    };
     run(fluid, 2);
     let mut out = Vec::new();
     for _ in 0..repeats {
@@ -118,7 +117,7 @@ fn time_steps(
 fn time_cpu<T: Real>(case: &LbmCase, repeats: usize) -> Result<(Vec<f64>, f64, Option<String>)> {
     let copy = copy_bandwidth(9 * case.nx * case.ny * std::mem::size_of::<T>());
     let mut lbm = shear_wave::<T>(case)?;
-    let samples = time_steps(case, repeats, &mut lbm, |f, n| f.steps(n))?;
+    let samples = time_steps(case, repeats, &mut lbm)?;
     Ok((samples, copy, None))
 }
 
@@ -133,10 +132,7 @@ fn time_gpu(case: &LbmCase, repeats: usize) -> Result<(Vec<f64>, f64, Option<Str
     ) -> Result<(Vec<f64>, f64, Option<String>)> {
         let copy = gpu.copy_bandwidth(9 * case.nx * case.ny * std::mem::size_of::<T>());
         let mut fluid = GpuFluid::new(&gpu, shear_wave::<T>(case)?).map_err(Error::Other)?;
-        let samples = time_steps(case, repeats, &mut fluid, |f, n| {
-            f.steps(n);
-            f.finish();
-        })?;
+        let samples = time_steps(case, repeats, &mut fluid)?;
         Ok((samples, copy, Some(gpu.name)))
     }
     let gpu = Gpu::new().map_err(Error::Other)?;

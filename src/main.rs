@@ -84,8 +84,8 @@ enum Command {
         /// Write each case's figures as `<DIR>/<name>.svg` (DIR is created if needed).
         #[arg(long, value_name = "DIR")]
         figures: Option<PathBuf>,
-        /// Where the fluid cases step; with gpu, `all` runs the cases the GPU back end has
-        /// (a build with --features gpu).
+        /// Where the fluid cases step; with gpu, `all` runs the fluid-only cases (a build with
+        /// --features gpu).
         #[arg(long, value_enum, default_value_t = Backend::Cpu)]
         backend: Backend,
     },

@@ -11,6 +11,7 @@
 //!   `crate::coupling::ladd`).
 //! * `gpu` (feature `gpu`): the same step on a GPU through wgpu.
 //! * [`solver`]: the solver in time, built from an [`LbmSetup`].
+//! * [`observation`]: the sums and probes a run watches between frames.
 
 pub mod backend;
 pub mod boundary;
@@ -20,6 +21,7 @@ pub mod d2q9;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod lattice;
+pub mod observation;
 pub mod obstacle;
 pub mod real;
 pub mod simd;
@@ -30,6 +32,7 @@ pub use boundary::{Edge, Edges};
 pub use collision::{Collider, CollisionModel, MrtRates};
 pub use covered::CoveredCells;
 pub use lattice::Lattice;
+pub use observation::Observation;
 pub use obstacle::{Obstacle, Obstacles, Shape};
 pub use real::{Populations, Real};
 pub use solver::{Fluid, FluidModel, Lbm, LbmSetup, LbmState, Macroscopic, STOP_MACH};

@@ -9,6 +9,7 @@ use super::collision::{Collider, CollisionModel};
 use super::covered::CoveredCells;
 use super::d2q9::{CX, CY, Q};
 use super::lattice::Lattice;
+use super::observation::{Observation, Partial};
 use super::obstacle::{Obstacle, Obstacles};
 use super::real::{Populations, Real};
 use crate::units::{Units, CS2};
@@ -286,6 +287,36 @@ impl<T: Real> Lbm<T> {
         m.solid = self.lattice.solid().to_vec();
     }
 
+    /// Sums over the fluid cells (in chunks of rows, combined in order: the same value on any
+    /// number of threads) and the state of the `probes` cells.
+    pub fn observe(&self, probes: &[usize]) -> Observation {
+        use rayon::prelude::*;
+        let nx = self.lattice.nx;
+        let rows = (4096 / nx).max(1);
+        let parts: Vec<Partial> = (0..self.lattice.ny.div_ceil(rows))
+            .into_par_iter()
+            .map(|k| {
+                let cells = k * rows * nx..((k + 1) * rows * nx).min(self.lattice.len());
+                cells
+                    .filter(|&c| !self.lattice.is_solid(c))
+                    .fold(Observation::EMPTY, |p, c| {
+                        Observation::add_cell(p, self.cell(c))
+                    })
+            })
+            .collect();
+        let probes = probes
+            .iter()
+            .map(|&c| {
+                if self.lattice.is_solid(c) {
+                    (1.0, 0.0, 0.0)
+                } else {
+                    self.cell(c)
+                }
+            })
+            .collect();
+        Observation::from_partials(parts, probes)
+    }
+
     /// First cell that is NaN, has ρ ≤ 0 or lattice Mach |u|/c_s > `max_mach`.
     pub fn find_instability(&self, max_mach: f64) -> Option<(usize, String)> {
         use rayon::prelude::*;
@@ -334,6 +365,8 @@ pub trait Fluid: Send {
     fn obstacle_loads(&self) -> (Vec<[f64; 2]>, Vec<f64>);
     /// Total fluid mass (lattice units).
     fn total_mass(&self) -> f64;
+    /// Sums over the fluid cells and the state of the `probes` cells (see [`Observation`]).
+    fn observe(&self, probes: &[usize]) -> Observation;
     /// Stop with [`Error::Unstable`] if a cell is NaN, ρ ≤ 0 or Mach > `max_mach`.
     fn check_stable(&self, max_mach: f64) -> Result<()>;
     /// Bytes of population storage.
@@ -369,6 +402,9 @@ impl<T: Real> Fluid for Lbm<T> {
     }
     fn total_mass(&self) -> f64 {
         self.lattice.total_mass()
+    }
+    fn observe(&self, probes: &[usize]) -> Observation {
+        Lbm::observe(self, probes)
     }
     fn check_stable(&self, max_mach: f64) -> Result<()> {
         match self.find_instability(max_mach) {

@@ -193,15 +193,17 @@ fn checks_only(checks: Result<Vec<Check>>) -> Result<Report> {
 /// A case that runs on either back end: its checks and references are the same on both.
 type OnBackend = fn(Fidelity, Backend) -> Result<Report>;
 
-/// The cases `validate --backend gpu` runs: the fluid cases whose lattices the GPU back end
-/// has (no Zou–He edges).
+/// The cases `validate --backend gpu` runs: every fluid-only case.
 pub const ON_ANY_BACKEND: &[(&str, OnBackend)] = &[
     ("poiseuille", poiseuille::run_on),
     ("taylor-green", taylor_green::run_on),
+    ("conservation", conservation::run_on),
     ("les-channel", les::run_on),
     ("cavity-re100", cavity::re100_on),
     ("cavity-re1000", cavity::re1000_on),
+    ("cylinder-2d1", cylinder::run_2d1_on),
     ("cylinder-array", cylinder::run_array_on),
+    ("shedding", cylinder::run_shedding_on),
 ];
 
 /// Run a case by name on `backend` (on the GPU: one of [`ON_ANY_BACKEND`]).
@@ -215,8 +217,8 @@ pub fn run_on(name: &str, fidelity: Fidelity, backend: Backend) -> Result<Report
         .ok_or_else(|| {
             let names: Vec<_> = ON_ANY_BACKEND.iter().map(|c| c.0).collect();
             crate::Error::Other(format!(
-                "validation case `{name}` does not run on the {} back end (Zou-He edges or \
-                 grains are not built there yet); cases that do: {}",
+                "validation case `{name}` does not run on the {} back end (grains in the \
+                 fluid are not built there yet); cases that do: {}",
                 backend.name(),
                 names.join(", ")
             ))

@@ -15,20 +15,22 @@
 //! when something is observed (a frame, a probe, a check, a checkpoint).
 //!
 //! Built: BGK and MRT, Smagorinsky LES, Guo forcing, periodic edges, half-way bounce-back
-//! walls at rest or moving, obstacles (half-way or Yu's interpolated bounce-back: a second
-//! kernel over the links after each step, which also stores the momentum each link exchanged;
-//! the loads are summed on the host in link order when observed, as the CPU sums them), in
-//! f32, and in f64 where the adapter offers `SHADER_F64`. Refused with the reason (run them
-//! with `backend = "cpu"`): Zou–He edges.
+//! walls at rest or moving, Zou–He velocity and pressure edges (the closure of
+//! [`super::boundary`] on the nodes the CPU plan marks, in the kernel's precision), obstacles
+//! (half-way or Yu's interpolated bounce-back: a second kernel over the links after each step,
+//! which also stores the momentum each link exchanged; the loads are summed on the host in link
+//! order when observed, as the CPU sums them), in f32, and in f64 where the adapter offers
+//! `SHADER_F64`.
 
 use std::cell::{Cell, Ref, RefCell};
 
 use wgpu::util::DeviceExt;
 
-use super::boundary::{Edges, Neighbour};
+use super::boundary::{Neighbour, ZouHe};
 use super::collision::{Collider, CollisionModel};
 use super::d2q9::Q;
 use super::lattice::Lattice;
+use super::observation::Observation;
 use super::obstacle::Obstacles;
 use super::real::Real;
 use super::solver::{Fluid, Lbm, LbmState, Macroscopic};
@@ -44,24 +46,13 @@ const STEPS_PER_SUBMIT: u64 = 256;
 /// `kind` of a bulk cell and of a solid cell (`stream_collide.wgsl`).
 const BULK: u32 = u32::MAX;
 const SOLID: u32 = u32::MAX - 1;
-/// Link-code bit of a bounce-back link.
+/// Link-code bit of a bounce-back link, and the code of an open (Zou–He) link.
 const BOUNCE: u32 = 1 << 31;
-
-/// Does the GPU back end have a fluid with these edges? Not yet: Zou–He edges (the reason
-/// says so, and what to use instead).
-pub fn supports(edges: &Edges) -> std::result::Result<(), String> {
-    if [&edges.left, &edges.right, &edges.bottom, &edges.top]
-        .iter()
-        .any(|e| e.is_zou_he())
-    {
-        return Err(
-            "Zou-He (velocity or pressure) edges are not built on the GPU back end \
-             yet: use backend = \"cpu\""
-                .into(),
-        );
-    }
-    Ok(())
-}
+const OPEN: u32 = u32::MAX;
+/// Storage buffers the step kernels bind (group 0), and the observation kernels besides them
+/// (group 1).
+const BINDINGS: u32 = 9;
+const OBSERVE_BINDINGS: u32 = 2;
 
 /// A GPU: the adapter wgpu picked, its device and queue.
 pub struct Gpu {
@@ -149,6 +140,41 @@ impl Gpu {
     }
 }
 
+/// A bind-group layout of `n` storage buffers for the compute stage, `written` ones
+/// read–write, the others read-only.
+fn bind_group_layout(
+    device: &wgpu::Device,
+    label: &str,
+    n: u32,
+    written: &[u32],
+) -> wgpu::BindGroupLayout {
+    let entries: Vec<wgpu::BindGroupLayoutEntry> = (0..n)
+        .map(|binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage {
+                    read_only: !written.contains(&binding),
+                },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        })
+        .collect();
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &entries,
+    })
+}
+
+/// The buffers of an observation: its probe cells, and where the row sums and probes land.
+struct Observer {
+    probes: Vec<u32>,
+    results: wgpu::Buffer,
+    group: wgpu::BindGroup,
+}
+
 /// A lattice's populations on the device, its obstacle links, and the pipelines that advance
 /// them: the step and the obstacles' after-step, each for an even and an odd step.
 pub struct GpuLattice {
@@ -158,21 +184,27 @@ pub struct GpuLattice {
     pipelines: [wgpu::ComputePipeline; 2],
     /// Obstacle after-step pipelines after an odd and after an even step.
     after: [wgpu::ComputePipeline; 2],
+    /// Row sums and probe pipelines before an odd and before an even step.
+    observers: [[wgpu::ComputePipeline; 2]; 2],
+    observe_layout: wgpu::BindGroupLayout,
+    /// The probe cells of the last observation, with its result buffer and bind group.
+    observation: RefCell<Option<Observer>>,
     /// Number of obstacle links, and the momentum each exchanged in the last step.
     links: u32,
     exchanged: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     f: wgpu::Buffer,
     groups: [u32; 2],
+    ny: u32,
     /// True when the next step is even.
     even: bool,
 }
 
 impl GpuLattice {
     /// Upload `lattice` (populations, parity, walls) with the links of its `obstacles` and
-    /// build the kernels for `collider`. Fails with the reason for what the device path does
-    /// not have (Zou–He edges, f64 without `SHADER_F64`, a lattice larger than the adapter's
-    /// buffers).
+    /// build the kernels for `collider`. Fails with the reason for what the adapter lacks
+    /// (`SHADER_F64` for f64, buffers as large as the lattice, nine storage buffers per
+    /// kernel).
     pub fn new<T: Real>(
         gpu: &Gpu,
         lattice: &Lattice<T>,
@@ -186,7 +218,6 @@ impl GpuLattice {
                 gpu.name
             ));
         }
-        supports(lattice.edges())?;
         let (nx, ny) = (lattice.nx, lattice.ny);
         let (pops, even) = lattice.state();
         let stride = pops.len() / Q;
@@ -198,6 +229,14 @@ impl GpuLattice {
                  buffer ({} MiB): use a smaller lattice or backend = \"cpu\"",
                 bytes >> 20,
                 limits.max_storage_buffer_binding_size >> 20
+            ));
+        }
+        let needed = BINDINGS + OBSERVE_BINDINGS;
+        if limits.max_storage_buffers_per_shader_stage < needed {
+            return Err(format!(
+                "the GPU adapter {} binds {} storage buffers per kernel, fewer than the {needed} \
+                 the lattice kernels need: use backend = \"cpu\"",
+                gpu.name, limits.max_storage_buffers_per_shader_stage
             ));
         }
         if ny as u32 > limits.max_compute_workgroups_per_dimension {
@@ -220,12 +259,28 @@ impl GpuLattice {
                 s.nb.map(|nb| match nb {
                     Neighbour::Fluid(k) => k,
                     Neighbour::Bounce(w) => BOUNCE | u32::from(w),
-                    Neighbour::Open => unreachable!("Zou-He lattices are refused above"),
+                    Neighbour::Open => OPEN,
                 })
             })
             .collect();
+        let mut zou_he: Vec<T> = lattice
+            .specials
+            .iter()
+            .flat_map(|s| {
+                let Some(node) = s.zou_he else {
+                    return [0.0; 5];
+                };
+                let [nx, ny] = node.normal.map(f64::from);
+                match node.value {
+                    ZouHe::Velocity([ux, uy]) => [1.0, nx, ny, ux, uy],
+                    ZouHe::Pressure(rho) => [2.0, nx, ny, rho, 0.0],
+                }
+            })
+            .map(T::c)
+            .collect();
         // A binding may not be empty.
         special_links.resize(special_links.len().max(Q), 0);
+        zou_he.resize(zou_he.len().max(5), T::zero());
         let corr: Vec<T> = lattice.wall_corr.iter().flatten().copied().collect();
         let mut solid_links: Vec<u32> = obstacles
             .links()
@@ -268,7 +323,7 @@ impl GpuLattice {
         let read = wgpu::BufferUsages::empty();
         let f = storage("populations", bytemuck::cast_slice(&pops), copy);
         let exchanged = storage("exchanged", bytemuck::cast_slice(&link_q), copy);
-        let buffers = [
+        let buffers: [&wgpu::Buffer; BINDINGS as usize] = [
             &f,
             &storage("kind", bytemuck::cast_slice(&kind), read),
             &storage("links", bytemuck::cast_slice(&special_links), read),
@@ -277,6 +332,7 @@ impl GpuLattice {
             &storage("obstacle links", bytemuck::cast_slice(&solid_links), read),
             &storage("link q", bytemuck::cast_slice(&link_q), read),
             &exchanged,
+            &storage("Zou-He nodes", bytemuck::cast_slice(&zou_he), read),
         ];
         let source = SOURCE.replacen(
             "alias real = f32;",
@@ -288,31 +344,22 @@ impl GpuLattice {
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
         // Bindings 0 (the populations) and 7 (the exchanged momenta) are written.
-        let layout_entries: Vec<wgpu::BindGroupLayoutEntry> = (0..buffers.len() as u32)
-            .map(|binding| wgpu::BindGroupLayoutEntry {
-                binding,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage {
-                        read_only: binding != 0 && binding != 7,
-                    },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            })
-            .collect();
-        let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("lattice"),
-            entries: &layout_entries,
-        });
+        let group_layout = bind_group_layout(&device, "lattice", BINDINGS, &[0, 7]);
+        // Group 1 of the observation kernels: binding 0 (the results) is written.
+        let observe_layout = bind_group_layout(&device, "observation", OBSERVE_BINDINGS, &[0]);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("lattice"),
             bind_group_layouts: &[&group_layout],
             push_constant_ranges: &[],
         });
+        let observe_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("observation"),
+                bind_group_layouts: &[&group_layout, &observe_layout],
+                push_constant_ranges: &[],
+            });
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
-        let pipeline = |entry: &str, even: bool| {
+        let pipeline = |entry: &str, even: bool, layout: &wgpu::PipelineLayout| {
             let constants = [
                 ("NX", nx as f64),
                 ("NY", ny as f64),
@@ -328,7 +375,7 @@ impl GpuLattice {
             ];
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
-                layout: Some(&layout),
+                layout: Some(layout),
                 module: &module,
                 entry_point: Some(entry),
                 compilation_options: wgpu::PipelineCompilationOptions {
@@ -338,8 +385,14 @@ impl GpuLattice {
                 cache: None,
             })
         };
-        let pipelines = [false, true].map(|even| pipeline("stream_collide", even));
-        let after = [false, true].map(|even| pipeline("after_step", even));
+        let pipelines = [false, true].map(|even| pipeline("stream_collide", even, &layout));
+        let after = [false, true].map(|even| pipeline("after_step", even, &layout));
+        let observers = [false, true].map(|even| {
+            [
+                pipeline("observe", even, &observe_pipeline_layout),
+                pipeline("probe", even, &observe_pipeline_layout),
+            ]
+        });
         let entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
             .enumerate()
@@ -358,11 +411,15 @@ impl GpuLattice {
             queue: gpu.queue.clone(),
             pipelines,
             after,
+            observers,
+            observe_layout,
+            observation: RefCell::new(None),
             links,
             exchanged,
             bind_group,
             f,
             groups: [(nx as u32).div_ceil(GROUP_X), ny as u32],
+            ny: ny as u32,
             even,
         })
     }
@@ -421,6 +478,78 @@ impl GpuLattice {
         values
     }
 
+    /// Sums over the fluid cells and the state of the `probes` cells as the next step will see
+    /// them, reduced on the device (`observe` and `probe` in the kernel source): 4 values per
+    /// row and 3 per probe come back, summed over the rows on the host in row order.
+    pub fn observe<T: Real>(&self, probes: &[usize]) -> Observation {
+        let cells: Vec<u32> = probes.iter().map(|&c| c as u32).collect();
+        let mut slot = self.observation.borrow_mut();
+        if slot.as_ref().is_none_or(|o| o.probes != cells) {
+            *slot = Some(self.observer::<T>(cells));
+        }
+        let o = slot.as_ref().expect("set above");
+        let [rows, probe] = &self.observers[usize::from(self.even)];
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_bind_group(0, &self.bind_group, &[]);
+            pass.set_bind_group(1, &o.group, &[]);
+            pass.set_pipeline(rows);
+            pass.dispatch_workgroups(1, self.ny, 1);
+            if !o.probes.is_empty() {
+                pass.set_pipeline(probe);
+                pass.dispatch_workgroups((o.probes.len() as u32).div_ceil(GROUP_X), 1, 1);
+            }
+        }
+        self.queue.submit([encoder.finish()]);
+        let v: Vec<f64> = self.read::<T>(&o.results).iter().map(|x| x.f64()).collect();
+        let (rows, probes) = v.split_at(4 * self.ny as usize);
+        Observation::from_partials(
+            rows.chunks_exact(4).map(|r| [r[0], r[1], r[2], r[3]]),
+            probes.chunks_exact(3).map(|p| (p[0], p[1], p[2])).collect(),
+        )
+    }
+
+    /// The buffers and bind group of an observation of the `probes` cells.
+    fn observer<T: Real>(&self, probes: Vec<u32>) -> Observer {
+        let cells: Vec<u32> = std::iter::once(probes.len() as u32)
+            .chain(probes.iter().copied())
+            .collect();
+        let values = 4 * self.ny as usize + 3 * probes.len();
+        let results = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("observation"),
+            size: (values * std::mem::size_of::<T>()) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let cells = self
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("probe cells"),
+                contents: bytemuck::cast_slice(&cells),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+        let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("observation"),
+            layout: &self.observe_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: results.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: cells.as_entire_binding(),
+                },
+            ],
+        });
+        Observer {
+            probes,
+            results,
+            group,
+        }
+    }
+
     /// Copy the device's populations and parity into `lattice` (built like the uploaded one).
     pub fn download<T: Real>(&self, lattice: &mut Lattice<T>) {
         lattice.set_state(self.read(&self.f), self.even);
@@ -442,23 +571,28 @@ impl GpuLattice {
 }
 
 /// A fluid that steps on the GPU: [`Fluid`] over a [`GpuLattice`] and a host copy of the
-/// solver, refreshed from the device only when something is observed.
+/// solver, whose populations are refreshed from the device only for what needs the whole
+/// lattice (fields, single cells, checkpoints) and whose obstacle loads only when asked for;
+/// sums, probes and stability checks are reduced on the device ([`GpuLattice::observe`]).
 pub struct GpuFluid<T> {
     host: RefCell<Lbm<T>>,
     device: GpuLattice,
-    /// True when the device is ahead of the host copy.
+    /// True when the device's populations are ahead of the host copy's …
     stale: Cell<bool>,
+    /// … and its obstacle loads.
+    stale_loads: Cell<bool>,
 }
 
 impl<T: Real> GpuFluid<T> {
-    /// Move `lbm` onto the GPU. Fails with the reason for what the device path does not have
-    /// (see the module docs).
+    /// Move `lbm` onto the GPU. Fails with the reason for what the adapter lacks (see
+    /// [`GpuLattice::new`]).
     pub fn new(gpu: &Gpu, lbm: Lbm<T>) -> std::result::Result<Self, String> {
         let device = GpuLattice::new(gpu, &lbm.lattice, &lbm.collider, &lbm.obstacles)?;
         Ok(GpuFluid {
             host: RefCell::new(lbm),
             device,
             stale: Cell::new(false),
+            stale_loads: Cell::new(false),
         })
     }
 
@@ -466,14 +600,22 @@ impl<T: Real> GpuFluid<T> {
     /// obstacle loads).
     pub fn host(&self) -> Ref<'_, Lbm<T>> {
         if self.stale.get() {
-            let host = &mut *self.host.borrow_mut();
-            self.device.download(&mut host.lattice);
-            if self.device.links > 0 {
-                host.obstacles.set_loads(&self.device.exchanged::<T>());
-            }
+            self.device.download(&mut self.host.borrow_mut().lattice);
             self.stale.set(false);
         }
+        self.refresh_loads();
         self.host.borrow()
+    }
+
+    /// Bring the host copy's obstacle loads up to date (the per-link momenta only come back).
+    fn refresh_loads(&self) {
+        if self.stale_loads.get() {
+            if self.device.links > 0 {
+                let exchanged = self.device.exchanged::<T>();
+                self.host.borrow_mut().obstacles.set_loads(&exchanged);
+            }
+            self.stale_loads.set(false);
+        }
     }
 }
 
@@ -482,6 +624,7 @@ impl<T: Real> Fluid for GpuFluid<T> {
         self.device.run(n);
         self.host.get_mut().steps += n;
         self.stale.set(true);
+        self.stale_loads.set(true);
     }
     fn finish(&self) {
         self.device.finish()
@@ -499,13 +642,22 @@ impl<T: Real> Fluid for GpuFluid<T> {
         self.host().cell(c)
     }
     fn obstacle_loads(&self) -> (Vec<[f64; 2]>, Vec<f64>) {
-        let host = self.host();
+        self.refresh_loads();
+        let host = self.host.borrow();
         (host.obstacles.force.clone(), host.obstacles.torque.clone())
     }
     fn total_mass(&self) -> f64 {
         self.host().lattice.total_mass()
     }
+    fn observe(&self, probes: &[usize]) -> Observation {
+        self.device.observe::<T>(probes)
+    }
+    /// On the device's sums; only when they show a problem is the lattice read back, to name
+    /// the first bad cell as the CPU does.
     fn check_stable(&self, max_mach: f64) -> Result<()> {
+        if self.device.observe::<T>(&[]).is_stable(max_mach) {
+            return Ok(());
+        }
         Fluid::check_stable(&*self.host(), max_mach)
     }
     fn bytes(&self) -> usize {
@@ -522,6 +674,7 @@ impl<T: Real> Fluid for GpuFluid<T> {
         host.set_state(s)?;
         self.device.upload(&host.lattice);
         self.stale.set(false);
+        self.stale_loads.set(false);
         Ok(())
     }
 }

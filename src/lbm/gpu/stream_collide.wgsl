@@ -5,6 +5,9 @@
 // f_i = A[x][i], collides and writes A[x][ī] = f_i*. Odd step: it reads f_i = A[x − e_i][ī] and
 // writes A[x + e_i][i] = f_i*; across a half-way bounce-back link it reads its own slot plus the
 // moving-wall term and writes back into its own opposite slot (seed eq. 5.24, Ladd 1994).
+// On a Zou–He node the populations arriving from outside the domain are unknown on either
+// parity: the closure of `lbm::boundary` sets them before the collision, and what leaves
+// through an open link is dropped.
 //
 // `real` is f32, or f64 where the adapter has SHADER_F64 (the host rewrites the alias).
 // Collision operators are those of `lbm::collision` term for term (see its docs for the
@@ -28,6 +31,8 @@ const BULK: u32 = 0xffffffffu;
 const SOLID: u32 = 0xfffffffeu;
 // A link code with this bit set is a bounce-back link; the low bits number its wall velocity.
 const BOUNCE: u32 = 0x80000000u;
+// The link code of an open link (out through a Zou–He edge).
+const OPEN: u32 = 0xffffffffu;
 
 @group(0) @binding(0) var<storage, read_write> f: array<real>;
 @group(0) @binding(1) var<storage, read> kind: array<u32>;
@@ -44,6 +49,9 @@ const BOUNCE: u32 = 0x80000000u;
 @group(0) @binding(6) var<storage, read> link_q: array<real>;
 // … and the momentum it exchanged in the last step, f_i*(x_f) + f_ī(x_f).
 @group(0) @binding(7) var<storage, read_write> exchanged: array<real>;
+// Per special node, 5 values: 0 (not a Zou–He node), 1 (velocity) or 2 (pressure), the
+// inward normal n_x, n_y, and the prescribed u_x, u_y or ρ.
+@group(0) @binding(8) var<storage, read> zou_he_nodes: array<real>;
 // Number of obstacle links.
 override LINKS: u32;
 const NONE: u32 = 0xffffffffu;
@@ -209,18 +217,80 @@ fn mrt(g: array<real, 9>) -> array<real, 9> {
     return o;
 }
 
-@compute @workgroup_size(64, 1, 1)
-fn stream_collide(@builtin(global_invocation_id) id: vec3<u32>) {
-    let x = id.x;
-    let y = id.y;
-    if (x >= NX || y >= NY) {
-        return;
+// The Zou–He closure of `lbm::boundary::zou_he` on special node `s` (see its docs): the
+// unknowns (bit i of `unknown`) from mass and normal momentum, ρ (1 − u·n) = Σ_known f (1 − e·n),
+// by bounce-back of their non-equilibrium part, f_i = f_ī + 6 w_i e_i·j, then corrected by
+// δ_i = λ + μ (e_i·t) to restore mass and tangential momentum. With Guo forcing the imposed
+// momentum is j = ρu − F/2.
+fn zou_he(g_in: array<real, 9>, unknown: u32, s: u32) -> array<real, 9> {
+    var g = g_in;
+    let nx = zou_he_nodes[5u * s + 1u];
+    let ny = zou_he_nodes[5u * s + 2u];
+    let tx = -ny;
+    let ty = nx;
+    let hx = select(0.0, 0.5 * coef[3], FORCE);
+    let hy = select(0.0, 0.5 * coef[4], FORCE);
+    var known: real = 0.0;
+    for (var i = 0u; i < 9u; i++) {
+        if ((unknown & (1u << i)) == 0u) {
+            known += g[i] * (1.0 - (real(CX[i]) * nx + real(CY[i]) * ny));
+        }
     }
-    let c = y * NX + x;
-    let k = kind[c];
-    if (k == SOLID) {
-        return;
+    var rho: real;
+    var jx: real;
+    var jy: real;
+    if (zou_he_nodes[5u * s] == 1.0) {
+        let ux = zou_he_nodes[5u * s + 3u];
+        let uy = zou_he_nodes[5u * s + 4u];
+        rho = (known - (hx * nx + hy * ny)) / (1.0 - (ux * nx + uy * ny));
+        jx = rho * ux - hx;
+        jy = rho * uy - hy;
+    } else {
+        rho = zou_he_nodes[5u * s + 3u];
+        let jn = rho - known;
+        let jt = -(hx * tx + hy * ty);
+        jx = jn * nx + jt * tx;
+        jy = jn * ny + jt * ty;
     }
+    var k: real = 0.0;
+    var st: real = 0.0;
+    var stt: real = 0.0;
+    for (var i = 0u; i < 9u; i++) {
+        if ((unknown & (1u << i)) != 0u) {
+            let w = select(W5, W1, i < 5u);
+            g[i] = g[OPP[i]] + 6.0 * w * (real(CX[i]) * jx + real(CY[i]) * jy);
+            let ct = real(CX[i]) * tx + real(CY[i]) * ty;
+            k += 1.0;
+            st += ct;
+            stt += ct * ct;
+        }
+    }
+    var mass: real = 0.0;
+    var tangential: real = 0.0;
+    for (var i = 0u; i < 9u; i++) {
+        mass += g[i];
+        tangential += g[i] * (real(CX[i]) * tx + real(CY[i]) * ty);
+    }
+    let r_m = rho - mass;
+    let r_t = (jx * tx + jy * ty) - tangential;
+    let det = k * stt - st * st;
+    var lambda = r_m / max(k, 1.0);
+    var mu: real = 0.0;
+    if (abs(det) > 1e-12) {
+        lambda = (r_m * stt - r_t * st) / det;
+        mu = (k * r_t - st * r_m) / det;
+    }
+    for (var i = 0u; i < 9u; i++) {
+        if ((unknown & (1u << i)) != 0u) {
+            g[i] = g[i] + lambda + mu * (real(CX[i]) * tx + real(CY[i]) * ty);
+        }
+    }
+    return g;
+}
+
+// The pre-collision populations of fluid cell (x, y) = c with kind k for a step of parity
+// EVEN (`Lattice::populations` on the CPU).
+fn gather(x: u32, y: u32, c: u32, k: u32) -> array<real, 9> {
     var g: array<real, 9>;
     if (EVEN) {
         for (var i = 0u; i < 9u; i++) {
@@ -236,11 +306,36 @@ fn stream_collide(@builtin(global_invocation_id) id: vec3<u32>) {
             let l = links[k * 9u + OPP[j]];
             if (l < BOUNCE) {
                 g[j] = f[OPP[j] * STRIDE + l];
-            } else {
+            } else if (l != OPEN) {
                 g[j] = f[j * STRIDE + c] + corr[(l & ~BOUNCE) * 9u + j];
             }
         }
     }
+    if (k != BULK && zou_he_nodes[5u * k] != 0.0) {
+        var unknown = 0u;
+        for (var j = 0u; j < 9u; j++) {
+            if (links[k * 9u + OPP[j]] == OPEN) {
+                unknown |= 1u << j;
+            }
+        }
+        g = zou_he(g, unknown, k);
+    }
+    return g;
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn stream_collide(@builtin(global_invocation_id) id: vec3<u32>) {
+    let x = id.x;
+    let y = id.y;
+    if (x >= NX || y >= NY) {
+        return;
+    }
+    let c = y * NX + x;
+    let k = kind[c];
+    if (k == SOLID) {
+        return;
+    }
+    let g = gather(x, y, c, k);
     var o: array<real, 9>;
     if (MRT) {
         o = mrt(g);
@@ -260,7 +355,7 @@ fn stream_collide(@builtin(global_invocation_id) id: vec3<u32>) {
             let l = links[k * 9u + i];
             if (l < BOUNCE) {
                 f[i * STRIDE + l] = o[i];
-            } else {
+            } else if (l != OPEN) {
                 f[OPP[i] * STRIDE + c] = o[i] - corr[(l & ~BOUNCE) * 9u + i];
             }
         }
@@ -299,4 +394,77 @@ fn after_step(@builtin(global_invocation_id) id: vec3<u32>) {
         f[o * STRIDE + c] = back;
     }
     exchanged[l] = out + back;
+}
+
+// Observation (`GpuFluid::observe`): the fields as the next step, of parity EVEN, will see
+// them, reduced without reading the populations back.
+//
+// Per row y, observed[4y..4y+4] = (Σρ, Σ ½ρ|u|², max |u|², min ρ) over its fluid cells; then per
+// probe p, observed[4 NY + 3p..] = (ρ, u_x, u_y) of cell probe_cells[1 + p] (probe_cells[0]
+// is the number of probes). u = (Σ f e + F/2)/ρ, as `Lbm::cell`.
+@group(1) @binding(0) var<storage, read_write> observed: array<real>;
+@group(1) @binding(1) var<storage, read> probe_cells: array<u32>;
+
+var<workgroup> partial: array<vec4<real>, 64>;
+
+// (ρ, u_x, u_y) of the populations g.
+fn moments(g: array<real, 9>) -> vec3<real> {
+    let rho = g[0] + g[1] + g[2] + g[3] + g[4] + g[5] + g[6] + g[7] + g[8];
+    let jx = g[1] - g[3] + g[5] - g[6] - g[7] + g[8];
+    let jy = g[2] - g[4] + g[5] + g[6] - g[7] - g[8];
+    let fx = select(0.0, coef[3], FORCE);
+    let fy = select(0.0, coef[4], FORCE);
+    return vec3<real>(rho, (jx + 0.5 * fx) / rho, (jy + 0.5 * fy) / rho);
+}
+
+// One workgroup per row; its 64 threads stride along the row, then reduce in a tree.
+@compute @workgroup_size(64, 1, 1)
+fn observe(@builtin(local_invocation_id) lid: vec3<u32>, @builtin(workgroup_id) wid: vec3<u32>) {
+    let y = wid.y;
+    var acc = vec4<real>(0.0, 0.0, 0.0, 1.0e30);
+    for (var x = lid.x; x < NX; x += 64u) {
+        let c = y * NX + x;
+        let k = kind[c];
+        if (k != SOLID) {
+            let m = moments(gather(x, y, c, k));
+            let u2 = m.y * m.y + m.z * m.z;
+            acc = vec4<real>(acc.x + m.x, acc.y + 0.5 * m.x * u2, max(acc.z, u2), min(acc.w, m.x));
+        }
+    }
+    partial[lid.x] = acc;
+    workgroupBarrier();
+    for (var s = 32u; s > 0u; s >>= 1u) {
+        if (lid.x < s) {
+            let a = partial[lid.x];
+            let b = partial[lid.x + s];
+            partial[lid.x] = vec4<real>(a.x + b.x, a.y + b.y, max(a.z, b.z), min(a.w, b.w));
+        }
+        workgroupBarrier();
+    }
+    if (lid.x == 0u) {
+        let r = partial[0];
+        observed[4u * y] = r.x;
+        observed[4u * y + 1u] = r.y;
+        observed[4u * y + 2u] = r.z;
+        observed[4u * y + 3u] = r.w;
+    }
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn probe(@builtin(global_invocation_id) id: vec3<u32>) {
+    let p = id.x;
+    if (p >= probe_cells[0]) {
+        return;
+    }
+    let c = probe_cells[1u + p];
+    let k = kind[c];
+    // A solid cell reads as fluid at rest, as `Macroscopic` has it.
+    var m = vec3<real>(1.0, 0.0, 0.0);
+    if (k != SOLID) {
+        m = moments(gather(c % NX, c / NX, c, k));
+    }
+    let o = 4u * NY + 3u * p;
+    observed[o] = m.x;
+    observed[o + 1u] = m.y;
+    observed[o + 2u] = m.z;
 }

@@ -112,7 +112,8 @@ pub fn run(
         }
         None => {
             let mut state = Outputs::create(scenario, &derived, out)?;
-            state.row(fluid.as_ref(), &mut macro_)?;
+            state.row(fluid.as_ref())?;
+            fluid.macroscopic(&mut macro_);
             state.write_frame(&macro_, 0.0)?;
             (state, Vec::new(), fluid.total_mass(), 0.0)
         }
@@ -145,17 +146,14 @@ pub fn run(
             }
             let row = s % derived.series_every == 0 || s == total;
             if row {
-                state.row(fluid.as_ref(), &mut macro_)?;
+                state.row(fluid.as_ref())?;
                 if s * 2 >= total {
                     lift.push(fluid.obstacle_loads().0.first().map_or(0.0, |f| f[1]));
                 }
             }
             let frame = s % derived.frame_every == 0 || s == total;
             if frame {
-                // A row just filled the fields; otherwise compute them for the frame.
-                if !row {
-                    fluid.macroscopic(&mut macro_);
-                }
+                fluid.macroscopic(&mut macro_);
                 state.write_frame(&macro_, s as f64 * dt)?;
             }
             let signal = control.stop_signal().filter(|_| s < total);
@@ -350,30 +348,19 @@ impl Outputs {
         header
     }
 
-    /// Append a time-series row; leaves the macroscopic fields in `m`.
-    fn row(&mut self, fluid: &dyn Fluid, m: &mut Macroscopic) -> Result<()> {
+    /// Append a time-series row (sums and probes reduced where the fluid lives).
+    fn row(&mut self, fluid: &dyn Fluid) -> Result<()> {
         let u = self.derived.units;
-        fluid.macroscopic(m);
+        let o = fluid.observe(&self.probes);
         let t = fluid.step_count() as f64 * u.dt;
-        let mass: f64 = (0..m.rho.len())
-            .filter(|&c| !m.solid[c])
-            .map(|c| m.rho[c])
-            .sum();
         let cell_area = u.dx * u.dx;
-        let mut ke = 0.0;
-        let mut umax: f64 = 0.0;
-        for c in (0..m.rho.len()).filter(|&c| !m.solid[c]) {
-            let s2 = m.ux[c] * m.ux[c] + m.uy[c] * m.uy[c];
-            ke += 0.5 * m.rho[c] * s2;
-            umax = umax.max(s2.sqrt());
-        }
         let v = u.velocity_to_si(1.0);
         let mut row = vec![
             t,
             fluid.step_count() as f64,
-            mass * self.rho0 * cell_area,
-            ke * self.rho0 * cell_area * v * v,
-            umax * v,
+            o.mass * self.rho0 * cell_area,
+            o.kinetic_energy * self.rho0 * cell_area * v * v,
+            o.max_speed * v,
         ];
         let (forces, torques) = fluid.obstacle_loads();
         for (f, tq) in forces.iter().zip(&torques) {
@@ -383,8 +370,8 @@ impl Outputs {
                 u.torque_to_si(*tq),
             ]);
         }
-        for &c in &self.probes {
-            row.extend([u.pressure_to_si(m.rho[c]), m.ux[c] * v, m.uy[c] * v]);
+        for &(rho, ux, uy) in &o.probes {
+            row.extend([u.pressure_to_si(rho), ux * v, uy * v]);
         }
         self.series.row(&row)
     }

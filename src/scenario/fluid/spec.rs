@@ -115,8 +115,7 @@ pub struct LbmSpec {
     /// `"f32"` or `"f64"`.
     pub precision: Precision,
     /// Where the lattice steps: `"cpu"` (the default) or `"gpu"` (a build with the `gpu`
-    /// feature; periodic edges, walls and obstacles, no Zou–He edges yet; f64 needs an
-    /// adapter with SHADER_F64).
+    /// feature; every edge type and obstacles; f64 needs an adapter with SHADER_F64).
     #[serde(default)]
     pub backend: crate::lbm::Backend,
     /// Smagorinsky constant C (seed eq. 5.38, ≈ 0.03 there); absent: no LES.
@@ -499,7 +498,7 @@ impl Scenario {
         };
         self.lbm
             .backend
-            .check(&self.edges(&units, nx, ny))
+            .check()
             .map_err(|e| Error::config("lbm.backend", e))?;
         Ok(Derived {
             units,

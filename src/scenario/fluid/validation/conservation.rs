@@ -18,6 +18,7 @@
 //! predicted −5.55e-13), BGK carried a similar bias. The collision now sets the rest population
 //! from the mass, f₀* = ρ − Σ_{i≥1} f_i*, and the drift is at round-off (≈ 4e-16).
 
+use crate::lbm::{Backend, Fluid};
 use crate::report::{Check, Fidelity, Plot, Report, Series};
 use crate::scenario::fluid::{CollisionKind, Scenario};
 use crate::scenario::ScenarioFile;
@@ -47,8 +48,9 @@ struct Budget {
     mass_history: Vec<(f64, f64)>,
 }
 
-/// Refine to `cells` per side at constant lattice Mach (Δt ∝ Δx) and set 10⁴ steps.
-fn resolve(sc: &mut Scenario, cells: usize, collision: CollisionKind) {
+/// Refine to `cells` per side at constant lattice Mach (Δt ∝ Δx), set 10⁴ steps, the collision
+/// and the back end.
+fn resolve(sc: &mut Scenario, cells: usize, collision: CollisionKind, backend: Backend) {
     let l = sc.domain.size[0];
     let dx = l / cells as f64;
     if let Some(dt) = sc.time.dt.as_mut() {
@@ -60,6 +62,7 @@ fn resolve(sc: &mut Scenario, cells: usize, collision: CollisionKind) {
     sc.time.end = STEPS as f64 * dt;
     sc.lbm.collision = collision;
     sc.lbm.mrt = None;
+    sc.lbm.backend = backend;
 }
 
 /// A vortical field with a mean flow and a density ripple, at speed scale `u` (lattice).
@@ -72,7 +75,8 @@ fn vortical(x: usize, y: usize, n: usize, u: f64) -> (f64, f64, f64) {
     (rho, ux, uy)
 }
 
-/// Run `sc` for [`STEPS`] steps (from the vortical field if `stir`) and take the budget.
+/// Run `sc` for [`STEPS`] steps (from the vortical field if `stir`) on its back end and take
+/// the budget.
 fn budget(sc: &Scenario, stir: bool) -> Result<Budget> {
     let d = sc.derive()?;
     let mut lbm = sc.build_typed::<f64>(&d)?;
@@ -81,37 +85,36 @@ fn budget(sc: &Scenario, stir: bool) -> Result<Budget> {
     if stir {
         lbm.lattice.fill(|x, y| vortical(x, y, nx, u));
     }
-    let momentum = |lbm: &crate::lbm::Lbm<f64>| -> [f64; 2] {
-        (0..nx * ny)
-            .filter(|&c| !lbm.lattice.is_solid(c))
-            .fold([0.0; 2], |p, c| {
-                let (r, ux, uy) = lbm.cell(c);
-                [p[0] + r * ux, p[1] + r * uy]
-            })
+    let fluid_cells: Vec<usize> = (0..nx * ny).filter(|&c| !lbm.lattice.is_solid(c)).collect();
+    let mut lbm = sc.on_backend(lbm)?;
+    let momentum = |lbm: &dyn Fluid| -> [f64; 2] {
+        fluid_cells.iter().fold([0.0; 2], |p, &c| {
+            let (r, ux, uy) = lbm.cell_state(c);
+            [p[0] + r * ux, p[1] + r * uy]
+        })
     };
-    let magnitude = |lbm: &crate::lbm::Lbm<f64>| -> f64 {
-        (0..nx * ny)
-            .filter(|&c| !lbm.lattice.is_solid(c))
-            .map(|c| {
-                let (r, ux, uy) = lbm.cell(c);
+    let magnitude = |lbm: &dyn Fluid| -> f64 {
+        fluid_cells
+            .iter()
+            .map(|&c| {
+                let (r, ux, uy) = lbm.cell_state(c);
                 r * ux.hypot(uy)
             })
             .sum()
     };
-    let m0 = lbm.lattice.total_mass();
-    let p0 = momentum(&lbm);
+    let m0 = lbm.total_mass();
+    let p0 = momentum(lbm.as_ref());
     let mut drift_max: f64 = 0.0;
     let mut mass_history = vec![(0.0, 0.0)];
-    for s in 1..=d.steps {
-        lbm.step();
-        if s % SAMPLE_EVERY == 0 {
-            let drift = ((lbm.lattice.total_mass() - m0) / m0).abs();
-            drift_max = drift_max.max(drift);
-            mass_history.push((s as f64, drift));
-        }
+    for s in (SAMPLE_EVERY..=d.steps).step_by(SAMPLE_EVERY as usize) {
+        lbm.steps(SAMPLE_EVERY);
+        let drift = ((lbm.total_mass() - m0) / m0).abs();
+        drift_max = drift_max.max(drift);
+        mass_history.push((s as f64, drift));
     }
-    let m1 = lbm.lattice.total_mass();
-    let p1 = momentum(&lbm);
+    lbm.steps(d.steps % SAMPLE_EVERY);
+    let m1 = lbm.total_mass();
+    let p1 = momentum(lbm.as_ref());
     let cells = (nx * ny) as f64;
     let [fx, fy] = d.force_lattice;
     let t = d.steps as f64;
@@ -122,13 +125,18 @@ fn budget(sc: &Scenario, stir: bool) -> Result<Budget> {
             p1[0] - p0[0] - cells * t * fx,
             p1[1] - p0[1] - cells * t * fy,
         ],
-        momentum_scale: magnitude(&lbm),
+        momentum_scale: magnitude(lbm.as_ref()),
         mass_history,
     })
 }
 
 /// Run the case.
 pub fn run(f: Fidelity) -> Result<Report> {
+    run_on(f, Backend::Cpu)
+}
+
+/// Run the case on `backend`.
+pub fn run_on(f: Fidelity, backend: Backend) -> Result<Report> {
     let cells = match f {
         Fidelity::Test => 64,
         Fidelity::Full => 128,
@@ -142,7 +150,7 @@ pub fn run(f: Fidelity) -> Result<Report> {
     );
     for (name, collision) in [("BGK", CollisionKind::Bgk), ("MRT", CollisionKind::Mrt)] {
         let mut closed = Scenario::from_toml(CLOSED)?;
-        resolve(&mut closed, cells, collision);
+        resolve(&mut closed, cells, collision, backend);
         let b = budget(&closed, false)?;
         plot = plot.with(Series::line(
             &format!("{name}, closed lid box"),
@@ -154,7 +162,7 @@ pub fn run(f: Fidelity) -> Result<Report> {
         checks.push(Check::report(CASE, &q, b.mass_drift_end, 0.0));
 
         let mut forced = Scenario::from_toml(PERIODIC)?;
-        resolve(&mut forced, cells, collision);
+        resolve(&mut forced, cells, collision, backend);
         let b = budget(&forced, true)?;
         plot = plot.with(Series::line(
             &format!("{name}, periodic box with force"),

@@ -101,28 +101,50 @@ fn stable(lbm: &dyn Fluid) -> Result<()> {
     lbm.check_stable(0.5)
 }
 
-/// (x, ρ, u_x) of each cell column on the horizontal line at height `y` (SI), linearly
-/// interpolated between the two bracketing rows; `None` where either cell is solid.
-fn axial_profile(lbm: &Lbm<f64>, y: f64) -> Vec<Option<(f64, f64, f64)>> {
-    let (nx, dx) = (lbm.lattice.nx, lbm.units.dx);
-    let s = (y / dx - 0.5).clamp(0.0, (lbm.lattice.ny - 1) as f64);
-    let j0 = (s.floor() as usize).min(lbm.lattice.ny - 2);
-    let t = s - j0 as f64;
-    (0..nx)
-        .map(|i| {
-            let (c0, c1) = (j0 * nx + i, (j0 + 1) * nx + i);
-            if lbm.lattice.is_solid(c0) || lbm.lattice.is_solid(c1) {
-                return None;
-            }
-            let (r0, u0, _) = lbm.cell(c0);
-            let (r1, u1, _) = lbm.cell(c1);
-            Some((
-                (i as f64 + 0.5) * dx,
-                (1.0 - t) * r0 + t * r1,
-                (1.0 - t) * u0 + t * u1,
-            ))
+/// A channel flow on either back end, with the solid map its profiles skip.
+struct ChannelFlow {
+    fluid: Box<dyn Fluid>,
+    solid: Vec<bool>,
+    cells: [usize; 2],
+}
+
+impl ChannelFlow {
+    /// The scenario's fluid in f64, started by `start` on the host, then moved onto the
+    /// scenario's back end.
+    fn build(scn: &Scenario, d: &Derived, start: impl FnOnce(&mut Lbm<f64>)) -> Result<Self> {
+        let mut lbm = scn.build_typed::<f64>(d)?;
+        start(&mut lbm);
+        let solid = lbm.lattice.solid().to_vec();
+        Ok(ChannelFlow {
+            fluid: scn.on_backend(lbm)?,
+            solid,
+            cells: d.cells,
         })
-        .collect()
+    }
+
+    /// (x, ρ, u_x) of each cell column on the horizontal line at height `y` (SI), linearly
+    /// interpolated between the two bracketing rows; `None` where either cell is solid.
+    fn axial_profile(&self, y: f64) -> Vec<Option<(f64, f64, f64)>> {
+        let ([nx, ny], dx) = (self.cells, self.fluid.units().dx);
+        let s = (y / dx - 0.5).clamp(0.0, (ny - 1) as f64);
+        let j0 = (s.floor() as usize).min(ny - 2);
+        let t = s - j0 as f64;
+        (0..nx)
+            .map(|i| {
+                let (c0, c1) = (j0 * nx + i, (j0 + 1) * nx + i);
+                if self.solid[c0] || self.solid[c1] {
+                    return None;
+                }
+                let (r0, u0, _) = self.fluid.cell_state(c0);
+                let (r1, u1, _) = self.fluid.cell_state(c1);
+                Some((
+                    (i as f64 + 0.5) * dx,
+                    (1.0 - t) * r0 + t * r1,
+                    (1.0 - t) * u0 + t * u1,
+                ))
+            })
+            .collect()
+    }
 }
 
 /// Lattice density at `x` on an axial profile: linear between the bracketing columns when both
@@ -190,18 +212,23 @@ impl Sample2d1 {
 /// Schäfer–Turek 2D-1: c_D within 1 % of 5.58 and Δp within 2 % at D ≥ 40 cells (Test: 40,
 /// Full: 80); L_a and c_L reported.
 pub fn run_2d1(fidelity: Fidelity) -> Result<Report> {
+    run_2d1_on(fidelity, Backend::Cpu)
+}
+
+/// Schäfer–Turek 2D-1 on `backend`.
+pub fn run_2d1_on(fidelity: Fidelity, backend: Backend) -> Result<Report> {
     let mut scn = Scenario::from_toml(TOML_2D1)?;
+    scn.lbm.backend = backend;
     if fidelity == Fidelity::Full {
         refine(&mut scn, 2.0);
     }
     let ch = Channel::of(&scn)?;
     let d = scn.derive()?;
-    let mut lbm = scn.build_typed::<f64>(&d)?;
-    start_as_channel_flow(&mut lbm, &d, ch.u_max);
-    let (m, drift, history) = run_to_steady(&mut lbm, &d, &ch)?;
+    let mut flow = ChannelFlow::build(&scn, &d, |lbm| start_as_channel_flow(lbm, &d, ch.u_max))?;
+    let (m, drift, history) = run_to_steady(&mut flow, &d, &ch)?;
     let case = "cylinder-2d1";
     let cells = ch.d / d.units.dx;
-    let plots = plots_2d1(&lbm, &d, &ch, history, cells);
+    let plots = plots_2d1(&flow, &d, &ch, history, cells);
     let checks = vec![
         // Gate of the issue: 1 % at D ≥ 40 cells (the published interval is ±0.2 %).
         Check::rel(case, "drag coefficient c_D", m.cd, st::CD, 0.01),
@@ -227,7 +254,7 @@ pub fn run_2d1(fidelity: Fidelity) -> Result<Report> {
 /// c_D against time beside the reference, and u_x on the centre line behind the cylinder with
 /// the reference end of the recirculation zone.
 fn plots_2d1(
-    lbm: &Lbm<f64>,
+    flow: &ChannelFlow,
     d: &Derived,
     ch: &Channel,
     history: Vec<(f64, f64)>,
@@ -257,7 +284,8 @@ fn plots_2d1(
     ))
     .with(Series::markers("LBM, mean over one acoustic period", means));
     let rear = ch.center[0] + 0.5 * ch.d;
-    let wake: Vec<(f64, f64)> = axial_profile(lbm, ch.center[1])
+    let wake: Vec<(f64, f64)> = flow
+        .axial_profile(ch.center[1])
         .into_iter()
         .flatten()
         .filter(|p| p.0 > rear)
@@ -310,7 +338,7 @@ fn start_as_channel_flow(lbm: &mut Lbm<f64>, d: &Derived, u_max_si: f64) {
 /// window-mean c_D changes by less than [`STEADY_TOL`] or at `time.end`. Returns the last
 /// window's means, the relative change and the history (t in s, c_D) of every sample.
 fn run_to_steady(
-    lbm: &mut Lbm<f64>,
+    flow: &mut ChannelFlow,
     d: &Derived,
     ch: &Channel,
 ) -> Result<(Sample2d1, f64, History)> {
@@ -321,13 +349,13 @@ fn run_to_steady(
     while steps < d.steps {
         let mut mean = Sample2d1::default();
         for k in 1..=WINDOW_SAMPLES {
-            let f = advance(lbm, every);
-            let sample = sample_2d1(lbm, d, ch, f)?;
+            let f = advance(flow.fluid.as_mut(), every);
+            let sample = sample_2d1(flow, d, ch, f)?;
             history.push(((steps + k * every) as f64 * d.units.dt, sample.cd));
             mean = mean.add(sample, 1.0 / WINDOW_SAMPLES as f64);
         }
         steps += every * WINDOW_SAMPLES;
-        stable(lbm)?;
+        stable(flow.fluid.as_ref())?;
         drift = ((mean.cd - last.cd) / mean.cd).abs();
         last = mean;
         if drift < STEADY_TOL {
@@ -338,8 +366,8 @@ fn run_to_steady(
 }
 
 /// c_D, c_L from the force `f` (lattice), Δp and L_a from the current fields.
-fn sample_2d1(lbm: &Lbm<f64>, d: &Derived, ch: &Channel, f: [f64; 2]) -> Result<Sample2d1> {
-    let profile = axial_profile(lbm, ch.center[1]);
+fn sample_2d1(flow: &ChannelFlow, d: &Derived, ch: &Channel, f: [f64; 2]) -> Result<Sample2d1> {
+    let profile = flow.axial_profile(ch.center[1]);
     let (front, rear) = (ch.center[0] - 0.5 * ch.d, ch.center[0] + 0.5 * ch.d);
     let p = |x: f64, side: i64| -> Result<f64> {
         density_at(&profile, d.units.dx, x, side)
@@ -553,16 +581,17 @@ fn lift_history(scn: &Scenario) -> Result<(Channel, LiftSeries)> {
     let d = scn.derive()?;
     let mut lbm = scn.build_typed::<f64>(&d)?;
     start_perturbed(&mut lbm, &d, &ch);
+    let mut lbm = scn.on_backend(lbm)?;
     let every = d.series_every.max(2);
     let mut cl = Vec::new();
     for k in 0..d.steps / every {
-        let f = advance(&mut lbm, every);
+        let f = advance(lbm.as_mut(), every);
         cl.push(ch.coefficient(d.units.force_to_si(f[1])));
         if k % 64 == 0 {
-            stable(&lbm)?;
+            stable(lbm.as_ref())?;
         }
     }
-    stable(&lbm)?;
+    stable(lbm.as_ref())?;
     Ok((
         ch,
         LiftSeries {
@@ -591,8 +620,15 @@ fn start_perturbed(lbm: &mut Lbm<f64>, d: &Derived, ch: &Channel) {
 /// Seed section 5.3: no sustained shedding at Re 55, shedding at Re 112; St reported beside
 /// Table 5.2.
 pub fn run_shedding(fidelity: Fidelity) -> Result<Report> {
+    run_shedding_on(fidelity, Backend::Cpu)
+}
+
+/// The shedding case on `backend`.
+pub fn run_shedding_on(fidelity: Fidelity, backend: Backend) -> Result<Report> {
     let mut lo = Scenario::from_toml(TOML_RE55)?;
     let mut hi = Scenario::from_toml(TOML_RE112)?;
+    lo.lbm.backend = backend;
+    hi.lbm.backend = backend;
     if fidelity == Fidelity::Full {
         refine(&mut lo, 2.0);
         refine(&mut hi, 2.0);

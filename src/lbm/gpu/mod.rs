@@ -4,15 +4,17 @@
 //! [`super::lattice`]) and runs the same in-place AA stream–collide (`stream_collide.wgsl`),
 //! one thread per cell, one dispatch per step. AA rather than two copies (A→B): it halves the
 //! device memory, moves the same 2·9 values per cell and step, and leaves the populations in
-//! exactly the CPU's state (values and parity), so a download is a CPU lattice again: frames,
-//! probes, stability checks and checkpoints use the CPU code unchanged, and a checkpoint taken
-//! on one back end resumes on the other.
+//! exactly the CPU's state (values and parity), so a download is a CPU lattice again: frames
+//! and checkpoints use the CPU code unchanged, and a checkpoint taken on one back end resumes
+//! on the other.
 //!
 //! Nodes whose 8 neighbours are fluid ("bulk") find their neighbours by index arithmetic;
 //! the others ("special": next to a wall or a solid) read a table of 9 link codes built from
 //! the CPU lattice's own plan, so both back ends apply the same bounce-back on the same
 //! links. The populations stay on the device between steps; [`GpuFluid`] downloads them only
-//! when something is observed (a frame, a probe, a check, a checkpoint).
+//! for what needs the whole lattice (a frame, a single cell, a checkpoint): time-series sums,
+//! probes and stability checks are reduced on the device (`observe` and `probe` in the kernel
+//! source), and obstacle loads read back the per-link momenta only.
 //!
 //! Built: BGK and MRT, Smagorinsky LES, Guo forcing, periodic edges, half-way bounce-back
 //! walls at rest or moving, Zou–He velocity and pressure edges (the closure of
@@ -194,8 +196,8 @@ pub struct GpuLattice {
     exchanged: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     f: wgpu::Buffer,
+    /// Workgroups of a step: along x, and one row each along y.
     groups: [u32; 2],
-    ny: u32,
     /// True when the next step is even.
     even: bool,
 }
@@ -203,7 +205,7 @@ pub struct GpuLattice {
 impl GpuLattice {
     /// Upload `lattice` (populations, parity, walls) with the links of its `obstacles` and
     /// build the kernels for `collider`. Fails with the reason for what the adapter lacks
-    /// (`SHADER_F64` for f64, buffers as large as the lattice, nine storage buffers per
+    /// (`SHADER_F64` for f64, buffers as large as the lattice, eleven storage buffers per
     /// kernel).
     pub fn new<T: Real>(
         gpu: &Gpu,
@@ -419,7 +421,6 @@ impl GpuLattice {
             bind_group,
             f,
             groups: [(nx as u32).div_ceil(GROUP_X), ny as u32],
-            ny: ny as u32,
             even,
         })
     }
@@ -495,7 +496,7 @@ impl GpuLattice {
             pass.set_bind_group(0, &self.bind_group, &[]);
             pass.set_bind_group(1, &o.group, &[]);
             pass.set_pipeline(rows);
-            pass.dispatch_workgroups(1, self.ny, 1);
+            pass.dispatch_workgroups(1, self.groups[1], 1);
             if !o.probes.is_empty() {
                 pass.set_pipeline(probe);
                 pass.dispatch_workgroups((o.probes.len() as u32).div_ceil(GROUP_X), 1, 1);
@@ -503,7 +504,7 @@ impl GpuLattice {
         }
         self.queue.submit([encoder.finish()]);
         let v: Vec<f64> = self.read::<T>(&o.results).iter().map(|x| x.f64()).collect();
-        let (rows, probes) = v.split_at(4 * self.ny as usize);
+        let (rows, probes) = v.split_at(4 * self.groups[1] as usize);
         Observation::from_partials(
             rows.chunks_exact(4).map(|r| [r[0], r[1], r[2], r[3]]),
             probes.chunks_exact(3).map(|p| (p[0], p[1], p[2])).collect(),
@@ -515,7 +516,7 @@ impl GpuLattice {
         let cells: Vec<u32> = std::iter::once(probes.len() as u32)
             .chain(probes.iter().copied())
             .collect();
-        let values = 4 * self.ny as usize + 3 * probes.len();
+        let values = 4 * self.groups[1] as usize + 3 * probes.len();
         let results = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("observation"),
             size: (values * std::mem::size_of::<T>()) as u64,

@@ -5,13 +5,22 @@
 //! One lattice step collides the covered cells with the partially saturated blend
 //! ([`super::psm`]) and then bounces the populations back on Ladd's links
 //! ([`super::ladd`]); with neither it is the plain fluid step.
+//!
+//! The lattice steps on the CPU, or on a GPU ([`CoupledFluid::on`], feature `gpu`) with the
+//! blend in the kernel ([`super::psm::collision::DEVICE_TERM`]): then per coupled step the
+//! covered cells go up and their exchanged momenta come back, and the populations stay on the
+//! device. Ladd's links run on the CPU only.
+
+use std::borrow::Cow;
+use std::ops::Deref;
 
 use rayon::prelude::*;
 
 use super::ladd::{BounceLinks, LinkCover, LinkForces};
 use super::psm::{weighting, PartialCells};
-use crate::lbm::{Lbm, LbmState, Real};
+use crate::lbm::{Backend, Lbm, LbmState, Real};
 use crate::scale::Scale;
+use crate::units::Units;
 use crate::{Error, Result};
 
 /// What a solid scale hands the fluid (SI): the cells it covers, ascending, with the exact
@@ -42,14 +51,42 @@ pub struct CellForces {
     pub links: LinkForces,
 }
 
+/// The lattice of a coupled fluid, on the back end it steps on.
+enum Lattices<T> {
+    Cpu(Lbm<T>),
+    #[cfg(feature = "gpu")]
+    Gpu(Box<crate::lbm::gpu::GpuFluid<T>>),
+}
+
+/// The fluid's solver as it stands ([`CoupledFluid::lbm`]).
+pub enum LbmRef<'a, T> {
+    /// Stepping on the CPU.
+    Cpu(&'a Lbm<T>),
+    /// The host copy of a fluid on a GPU, brought up to date.
+    #[cfg(feature = "gpu")]
+    Gpu(std::cell::Ref<'a, Lbm<T>>),
+}
+
+impl<T> Deref for LbmRef<'_, T> {
+    type Target = Lbm<T>;
+    fn deref(&self) -> &Lbm<T> {
+        match self {
+            LbmRef::Cpu(l) => l,
+            #[cfg(feature = "gpu")]
+            LbmRef::Gpu(l) => l,
+        }
+    }
+}
+
 /// The LBM and the state of the coupling methods between it and the solids.
 pub struct CoupledFluid<T> {
     /// The fluid.
-    pub lbm: Lbm<T>,
+    fluid: Lattices<T>,
     /// Cells partially covered by moving solids (empty: none).
     pub partial: PartialCells<T>,
     /// Momentum the solid term gave the fluid at each covered cell in the last step (lattice
     /// units), in the order of [`PartialCells::cells`]; the force on the solid is its negative.
+    /// On a GPU it stays on the device: see [`CoupledFluid::exchanged`].
     pub exchange: Vec<[f64; 2]>,
     /// Momentum exchanged per covered cell summed over the steps of the last
     /// [`Scale::advance`], and their number (the sum is kept only for more than one step;
@@ -72,35 +109,126 @@ pub struct CoupledFluidState<T> {
 }
 
 impl<T: Real> CoupledFluid<T> {
+    /// The fluid `lbm` with no solid in it yet, stepping on the CPU.
+    pub fn new(lbm: Lbm<T>) -> Self {
+        CoupledFluid {
+            fluid: Lattices::Cpu(lbm),
+            partial: PartialCells::new(),
+            exchange: Vec::new(),
+            exchange_sum: (Vec::new(), 0),
+            ladd: BounceLinks::default(),
+        }
+    }
+
+    /// The same fluid on `backend`: on `gpu` its populations move to the device, which then
+    /// also blends the covered cells. Fails with the reason when the back end is not built,
+    /// finds no adapter or lacks something the fluid uses.
+    pub fn on(self, backend: Backend) -> Result<Self> {
+        backend.check().map_err(Error::Other)?;
+        match (backend, self.fluid) {
+            #[cfg(feature = "gpu")]
+            (Backend::Gpu, Lattices::Cpu(lbm)) => {
+                let gpu = crate::lbm::gpu::Gpu::new().map_err(Error::Other)?;
+                let term = super::psm::collision::DEVICE_TERM;
+                let dev = crate::lbm::gpu::GpuFluid::with_term(&gpu, lbm, Some(&term))
+                    .map_err(Error::Other)?;
+                let mut moved = CoupledFluid {
+                    fluid: Lattices::Gpu(Box::new(dev)),
+                    ..self
+                };
+                moved.upload_cover();
+                Ok(moved)
+            }
+            (_, fluid) => Ok(CoupledFluid { fluid, ..self }),
+        }
+    }
+
+    /// The back end the lattice steps on.
+    pub fn backend(&self) -> Backend {
+        match self.fluid {
+            Lattices::Cpu(_) => Backend::Cpu,
+            #[cfg(feature = "gpu")]
+            Lattices::Gpu(_) => Backend::Gpu,
+        }
+    }
+
+    /// The fluid's solver, up to date (on a GPU: its host copy, downloaded when behind).
+    pub fn lbm(&self) -> LbmRef<'_, T> {
+        match &self.fluid {
+            Lattices::Cpu(l) => LbmRef::Cpu(l),
+            #[cfg(feature = "gpu")]
+            Lattices::Gpu(g) => LbmRef::Gpu(g.host()),
+        }
+    }
+
+    /// The fluid's units (without bringing a GPU's host copy up to date).
+    pub fn units(&self) -> Units {
+        match &self.fluid {
+            Lattices::Cpu(l) => l.units,
+            #[cfg(feature = "gpu")]
+            Lattices::Gpu(g) => crate::lbm::Fluid::units(g.as_ref()),
+        }
+    }
+
     /// A copy of the state that changes as it runs.
     pub fn state(&self) -> CoupledFluidState<T> {
+        let (exchange, exchange_sum) = match self.exchange_sums() {
+            (sums, 1) => (sums.into_owned(), (Vec::new(), self.exchange_sum.1)),
+            // The last step's own exchange is not needed to continue.
+            (sums, k) => (self.exchange.clone(), (sums.into_owned(), k)),
+        };
         CoupledFluidState {
-            lbm: self.lbm.state(),
+            lbm: self.lbm().state(),
             partial: self.partial.clone(),
-            exchange: self.exchange.clone(),
-            exchange_sum: self.exchange_sum.clone(),
+            exchange,
+            exchange_sum,
             ladd: self.ladd.clone(),
         }
     }
 
     /// Continue from a state taken by [`CoupledFluid::state`] of a fluid built the same way.
     pub fn set_state(&mut self, s: CoupledFluidState<T>) -> Result<()> {
-        self.lbm.set_state(s.lbm)?;
+        match &mut self.fluid {
+            Lattices::Cpu(l) => l.set_state(s.lbm)?,
+            #[cfg(feature = "gpu")]
+            Lattices::Gpu(g) => crate::lbm::Fluid::set_state(g.as_mut(), s.lbm)?,
+        }
         self.partial = s.partial;
         self.exchange = s.exchange;
         self.exchange_sum = s.exchange_sum;
         self.ladd = s.ladd;
+        self.upload_cover();
+        #[cfg(feature = "gpu")]
+        if let Lattices::Gpu(g) = &mut self.fluid {
+            // The device holds the sums over the steps of the advance.
+            let sums = match self.exchange_sum.1 {
+                0 | 1 => &self.exchange,
+                _ => &self.exchange_sum.0,
+            };
+            g.lattice_mut().set_covered_exchange::<T>(sums);
+        }
         Ok(())
     }
 
-    /// The fluid `lbm` with no solid in it yet.
-    pub fn new(lbm: Lbm<T>) -> Self {
-        CoupledFluid {
-            lbm,
-            partial: PartialCells::new(),
-            exchange: Vec::new(),
-            exchange_sum: (Vec::new(), 0),
-            ladd: BounceLinks::default(),
+    /// The momentum each covered cell's solid term gave the fluid (lattice units), summed
+    /// over the steps of the last advance, and their number (at least 1): on the CPU from
+    /// [`CoupledFluid::exchange`] or the step sum, on a GPU the device's sums (read back).
+    fn exchange_sums(&self) -> (Cow<'_, [[f64; 2]]>, u64) {
+        let k = self.exchange_sum.1.max(1);
+        match &self.fluid {
+            Lattices::Cpu(_) if k == 1 => (Cow::Borrowed(&self.exchange), 1),
+            Lattices::Cpu(_) => (Cow::Borrowed(&self.exchange_sum.0), k),
+            #[cfg(feature = "gpu")]
+            Lattices::Gpu(g) => (Cow::Owned(g.lattice().covered_exchange::<T>()), k),
+        }
+    }
+
+    /// Put the covered cells on the device (a fluid on a GPU; nothing on the CPU).
+    fn upload_cover(&mut self) {
+        #[cfg(feature = "gpu")]
+        if let Lattices::Gpu(g) = &mut self.fluid {
+            let values = self.partial.device_values();
+            g.lattice_mut().set_cover(&self.partial.cells, &values);
         }
     }
 
@@ -109,21 +237,27 @@ impl<T: Real> CoupledFluid<T> {
     pub fn step(&mut self) {
         // Cells pushed by hand since the last cover get an exchange entry too.
         self.exchange.resize(self.partial.len(), [0.0; 2]);
-        let links = &mut self.ladd;
-        self.lbm
-            .step_covered(&self.partial, &mut self.exchange, |lat, was_even| {
-                if !links.is_empty() {
-                    links.bounce(lat, was_even);
-                }
-            });
+        match &mut self.fluid {
+            Lattices::Cpu(lbm) => {
+                let links = &mut self.ladd;
+                lbm.step_covered(&self.partial, &mut self.exchange, |lat, was_even| {
+                    if !links.is_empty() {
+                        links.bounce(lat, was_even);
+                    }
+                });
+            }
+            #[cfg(feature = "gpu")]
+            Lattices::Gpu(g) => crate::lbm::Fluid::steps(g.as_mut(), 1),
+        }
     }
 
     /// Set the covered cells from a solid cover in SI: B = B(ε, τ) of [`weighting`] with the
     /// molecular τ, velocities converted to lattice units; the exchange is zeroed.
     /// Cells must be ascending.
     pub fn set_cover(&mut self, cover: &SolidCover) {
+        let units = self.units();
         let p = &mut self.partial;
-        let (tau, units, n) = (self.lbm.units.tau, &self.lbm.units, cover.cells.len());
+        let (tau, n) = (units.tau, cover.cells.len());
         p.cells.clear();
         p.cells.extend_from_slice(&cover.cells);
         // Resized (a cover changes little between steps), then overwritten in one pass.
@@ -147,12 +281,30 @@ impl<T: Real> CoupledFluid<T> {
                 *uy = T::c(units.velocity_to_lattice(vy));
                 *ex = [0.0; 2];
             });
+        self.upload_cover();
+    }
+
+    /// Set Ladd's boundary links from a solid cover (on the CPU only: fails on a GPU).
+    pub fn set_links(&mut self, links: &LinkCover) -> Result<()> {
+        match &mut self.fluid {
+            Lattices::Cpu(lbm) => {
+                self.ladd.set(&mut lbm.lattice, links, &lbm.units);
+                Ok(())
+            }
+            #[cfg(feature = "gpu")]
+            Lattices::Gpu(_) => Err(Error::Other(
+                "Ladd's bounce-back (coupling.method = \"ladd\") runs on the CPU only: use \
+                 backend = \"cpu\", or the partially saturated cells"
+                    .into(),
+            )),
+        }
     }
 
     /// Total fluid momentum (lattice units, see [`Lbm::momentum`]); nodes inside solids under
     /// Ladd's bounce-back are not fluid and not counted.
     pub fn momentum(&self) -> [f64; 2] {
-        self.lbm.momentum(|c| self.ladd.is_inside(c))
+        let ladd = &self.ladd;
+        self.lbm().momentum(|c| ladd.is_inside(c))
     }
 }
 
@@ -164,37 +316,44 @@ impl<T: Real> Scale for CoupledFluid<T> {
     type Snapshot = LbmState;
 
     fn time(&self) -> f64 {
-        self.lbm.steps as f64 * self.lbm.units.dt
+        let steps = match &self.fluid {
+            Lattices::Cpu(l) => l.steps,
+            #[cfg(feature = "gpu")]
+            Lattices::Gpu(g) => crate::lbm::Fluid::step_count(g.as_ref()),
+        };
+        steps as f64 * self.units().dt
     }
     /// The lattice step: the fluid advances in whole lattice steps.
     fn max_dt(&self) -> f64 {
-        self.lbm.units.dt
+        self.units().dt
     }
     /// Advance by `dt`, which must be a whole number of lattice steps (within 1e-9).
     fn advance(&mut self, input: &SolidCover, dt: f64) -> Result<()> {
-        let n = dt / self.lbm.units.dt;
+        let units = self.units();
+        let n = dt / units.dt;
         let k = n.round();
         if (n - k).abs() > 1e-9 * n.max(1.0) || k < 1.0 {
             return Err(Error::Other(format!(
                 "LBM advance: dt = {dt:e} s is not a whole number of lattice steps ({:e} s)",
-                self.lbm.units.dt
+                units.dt
             )));
         }
         self.set_cover(input);
         if !(input.links.is_empty() && self.ladd.is_empty()) {
-            self.ladd
-                .set(&mut self.lbm.lattice, &input.links, &self.lbm.units);
+            self.set_links(&input.links)?;
         }
         let steps = k as u64;
+        let on_cpu = self.backend() == Backend::Cpu;
         let (sum, count) = &mut self.exchange_sum;
         sum.clear();
-        if steps > 1 {
+        if steps > 1 && on_cpu {
             sum.resize(input.cells.len(), [0.0; 2]);
         }
         *count = steps;
         for _ in 0..steps {
             self.step();
-            if steps > 1 {
+            // On a GPU the device sums the steps' exchange itself.
+            if steps > 1 && on_cpu {
                 self.exchange_sum
                     .0
                     .par_iter_mut()
@@ -209,24 +368,23 @@ impl<T: Real> Scale for CoupledFluid<T> {
     }
     /// Force on the solid per covered cell, F = −Δp (N/m), seed eq. 5.53.
     fn observe(&self, out: &mut CellForces) {
-        // One step: its own exchange; several: their sum.
-        let (sum, count) = match self.exchange_sum {
-            (_, 0 | 1) => (&self.exchange, 1),
-            (ref sum, k) => (sum, k),
-        };
+        let (sum, count) = self.exchange_sums();
         let k = count as f64;
-        let u = &self.lbm.units;
+        let u = self.units();
         sum.par_iter()
             .map(|s| (-u.force_to_si(s[0] / k), -u.force_to_si(s[1] / k)))
             .unzip_into_vecs(&mut out.fx, &mut out.fy);
-        self.ladd.observe(&self.lbm.units, &mut out.links);
+        self.ladd.observe(&u, &mut out.links);
     }
     fn snapshot(&self) -> LbmState {
-        self.lbm.state()
+        self.lbm().state()
     }
     fn restore(&mut self, s: LbmState) {
-        self.lbm
-            .set_state(s)
-            .expect("a snapshot of this fluid restores into it");
+        let restored = match &mut self.fluid {
+            Lattices::Cpu(l) => l.set_state(s),
+            #[cfg(feature = "gpu")]
+            Lattices::Gpu(g) => crate::lbm::Fluid::set_state(g.as_mut(), s),
+        };
+        restored.expect("a snapshot of this fluid restores into it");
     }
 }

@@ -193,7 +193,8 @@ fn checks_only(checks: Result<Vec<Check>>) -> Result<Report> {
 /// A case that runs on either back end: its checks and references are the same on both.
 type OnBackend = fn(Fidelity, Backend) -> Result<Report>;
 
-/// The cases `validate --backend gpu` runs: every fluid-only case.
+/// The cases `validate --backend gpu` runs: every fluid-only case, and the coupled cases of
+/// the partially saturated cells at test size (momentum, settling disk).
 pub const ON_ANY_BACKEND: &[(&str, OnBackend)] = &[
     ("poiseuille", poiseuille::run_on),
     ("taylor-green", taylor_green::run_on),
@@ -204,6 +205,8 @@ pub const ON_ANY_BACKEND: &[(&str, OnBackend)] = &[
     ("cylinder-2d1", cylinder::run_2d1_on),
     ("cylinder-array", cylinder::run_array_on),
     ("shedding", cylinder::run_shedding_on),
+    ("coupling-momentum", psm::momentum_on),
+    ("settling-disk", psm::settling_on),
 ];
 
 /// Run a case by name on `backend` (on the GPU: one of [`ON_ANY_BACKEND`]).
@@ -217,8 +220,7 @@ pub fn run_on(name: &str, fidelity: Fidelity, backend: Backend) -> Result<Report
         .ok_or_else(|| {
             let names: Vec<_> = ON_ANY_BACKEND.iter().map(|c| c.0).collect();
             crate::Error::Other(format!(
-                "validation case `{name}` does not run on the {} back end (grains in the \
-                 fluid are not built there yet); cases that do: {}",
+                "validation case `{name}` does not run on the {} back end; cases that do: {}",
                 backend.name(),
                 names.join(", ")
             ))

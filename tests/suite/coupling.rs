@@ -72,8 +72,8 @@ fn zero_weight_matches_plain<T: granflow::lbm::Real>(model: CollisionModel, les:
     }
     for c in 0..nx * ny {
         let (a, b) = (
-            plain.lbm.lattice.populations(c),
-            covered.lbm.lattice.populations(c),
+            plain.lbm().lattice.populations(c),
+            covered.lbm().lattice.populations(c),
         );
         assert_eq!(a, b, "cell {c}");
     }

@@ -67,7 +67,7 @@ fn ladd_f32_mrt_les_in_the_driver() {
     for _ in 0..300 {
         c.step().unwrap();
     }
-    granflow::lbm::Fluid::check_stable(&c.fluid.lbm, 0.3).unwrap();
+    granflow::lbm::Fluid::check_stable(&*c.fluid.lbm(), 0.3).unwrap();
     let gr = &c.solid.grains;
     println!(
         "x − x0 = {}, vx = {}, ω = {}",

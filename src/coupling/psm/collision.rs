@@ -23,6 +23,15 @@ use crate::lbm::collision::Collider;
 use crate::lbm::d2q9::{equilibrium, CX, CY, OPP, Q, W};
 use crate::lbm::{CoveredCells, Real};
 
+/// The blend on the GPU: the lattice kernel's covered-cells term, (B, u_s,x, u_s,y) per cell
+/// ([`PartialCells::device_values`]). In the kernel's precision, with Ω^s rearranged so that
+/// f32 keeps the digits the CPU keeps in f64 (see the source).
+#[cfg(feature = "gpu")]
+pub const DEVICE_TERM: crate::lbm::gpu::CoveredTerm = crate::lbm::gpu::CoveredTerm {
+    source: include_str!("collision.wgsl"),
+    values: 3,
+};
+
 /// Noble & Torczynski's weighting B(ε, τ) = ε(τ − ½)/((1 − ε) + (τ − ½)) of the solid
 /// fraction ε ∈ [0, 1] (clamped) for relaxation time τ.
 pub fn weighting(eps: f64, tau: f64) -> f64 {
@@ -75,6 +84,14 @@ impl<T: Real> PartialCells<T> {
         self.b.clear();
         self.ux.clear();
         self.uy.clear();
+    }
+
+    /// The values of [`DEVICE_TERM`]: (B, u_x, u_y) per cell, cell after cell.
+    #[cfg(feature = "gpu")]
+    pub fn device_values(&self) -> Vec<T> {
+        (0..self.len())
+            .flat_map(|k| [self.b[k], self.ux[k], self.uy[k]])
+            .collect()
     }
 
     /// Append a cell (call in ascending cell order).

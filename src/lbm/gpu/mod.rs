@@ -39,6 +39,10 @@ use super::solver::{Fluid, Lbm, LbmState, Macroscopic};
 use crate::units::Units;
 use crate::Result;
 
+mod covered;
+
+pub use covered::CoveredTerm;
+
 /// The kernel's source, with `alias real = f32;` rewritten for f64.
 const SOURCE: &str = include_str!("stream_collide.wgsl");
 /// Threads per workgroup along x (the kernel's `@workgroup_size`).
@@ -53,7 +57,14 @@ const BOUNCE: u32 = 1 << 31;
 const OPEN: u32 = u32::MAX;
 /// Storage buffers the step kernels bind (group 0), and the observation kernels besides them
 /// (group 1).
-const BINDINGS: u32 = 9;
+const BINDINGS: u32 = 12;
+/// Group-0 bindings of the populations, the obstacle links' momenta and the covered cells'
+/// index, values and momenta.
+const F: usize = 0;
+const EXCHANGED: usize = 7;
+const COVERED_INDEX: usize = 9;
+const COVERED_VALUES: usize = 10;
+const COVERED_EXCHANGE: usize = 11;
 const OBSERVE_BINDINGS: u32 = 2;
 
 /// A GPU: the adapter wgpu picked, its device and queue.
@@ -142,6 +153,44 @@ impl Gpu {
     }
 }
 
+/// A storage buffer of `bytes` bytes (at least 4: a binding may not be empty), initialised to
+/// zero.
+fn zeroed(
+    device: &wgpu::Device,
+    label: &str,
+    bytes: usize,
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(4).next_multiple_of(4) as u64,
+        usage: wgpu::BufferUsages::STORAGE | usage,
+        mapped_at_creation: false,
+    })
+}
+
+/// A bind group of `buffers` at bindings 0, 1, … of `layout`.
+fn bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
 /// A bind-group layout of `n` storage buffers for the compute stage, `written` ones
 /// read–write, the others read-only.
 fn bind_group_layout(
@@ -191,11 +240,15 @@ pub struct GpuLattice {
     observe_layout: wgpu::BindGroupLayout,
     /// The probe cells of the last observation, with its result buffer and bind group.
     observation: RefCell<Option<Observer>>,
-    /// Number of obstacle links, and the momentum each exchanged in the last step.
+    /// Number of obstacle links.
     links: u32,
-    exchanged: wgpu::Buffer,
+    /// The buffers of group 0 (populations at [`F`], the obstacle links' momenta at
+    /// [`EXCHANGED`], the covered cells at [`COVERED_INDEX`] …), its layout and bind group.
+    buffers: Vec<wgpu::Buffer>,
+    group_layout: wgpu::BindGroupLayout,
     bind_group: wgpu::BindGroup,
-    f: wgpu::Buffer,
+    /// The covered cells of a coupling's term, when built with one.
+    cover: Option<covered::DeviceCover>,
     /// Workgroups of a step: along x, and one row each along y.
     groups: [u32; 2],
     /// True when the next step is even.
@@ -204,14 +257,16 @@ pub struct GpuLattice {
 
 impl GpuLattice {
     /// Upload `lattice` (populations, parity, walls) with the links of its `obstacles` and
-    /// build the kernels for `collider`. Fails with the reason for what the adapter lacks
-    /// (`SHADER_F64` for f64, buffers as large as the lattice, eleven storage buffers per
+    /// build the kernels for `collider`, with the covered cells' `term` of a coupling when
+    /// given ([`CoveredTerm`]). Fails with the reason for what the adapter lacks
+    /// (`SHADER_F64` for f64, buffers as large as the lattice, fourteen storage buffers per
     /// kernel).
     pub fn new<T: Real>(
         gpu: &Gpu,
         lattice: &Lattice<T>,
         collider: &Collider<T>,
         obstacles: &Obstacles,
+        term: Option<&CoveredTerm>,
     ) -> std::result::Result<Self, String> {
         if T::NAME == "f64" && !gpu.f64 {
             return Err(format!(
@@ -323,20 +378,29 @@ impl GpuLattice {
         };
         let copy = wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let read = wgpu::BufferUsages::empty();
-        let f = storage("populations", bytemuck::cast_slice(&pops), copy);
-        let exchanged = storage("exchanged", bytemuck::cast_slice(&link_q), copy);
-        let buffers: [&wgpu::Buffer; BINDINGS as usize] = [
-            &f,
-            &storage("kind", bytemuck::cast_slice(&kind), read),
-            &storage("links", bytemuck::cast_slice(&special_links), read),
-            &storage("wall terms", bytemuck::cast_slice(&corr), read),
-            &storage("collision", bytemuck::cast_slice(&coef), read),
-            &storage("obstacle links", bytemuck::cast_slice(&solid_links), read),
-            &storage("link q", bytemuck::cast_slice(&link_q), read),
-            &exchanged,
-            &storage("Zou-He nodes", bytemuck::cast_slice(&zou_he), read),
+        let cells = nx * ny;
+        let buffers = vec![
+            storage("populations", bytemuck::cast_slice(&pops), copy),
+            storage("kind", bytemuck::cast_slice(&kind), read),
+            storage("links", bytemuck::cast_slice(&special_links), read),
+            storage("wall terms", bytemuck::cast_slice(&corr), read),
+            storage("collision", bytemuck::cast_slice(&coef), read),
+            storage("obstacle links", bytemuck::cast_slice(&solid_links), read),
+            storage("link q", bytemuck::cast_slice(&link_q), read),
+            storage("exchanged", bytemuck::cast_slice(&link_q), copy),
+            storage("Zou-He nodes", bytemuck::cast_slice(&zou_he), read),
+            // The covered cells: an index per cell (only with a term; none covered), entries'
+            // values and momenta (grown by `set_cover`).
+            storage(
+                "covered index",
+                bytemuck::cast_slice(&vec![u32::MAX; if term.is_some() { cells } else { 1 }]),
+                read,
+            ),
+            zeroed(&device, "covered values", 4, copy),
+            zeroed(&device, "covered exchange", 4, copy),
         ];
-        let source = SOURCE.replacen(
+        let term_source = term.map_or(covered::NO_TERM, |t| t.source);
+        let source = format!("{SOURCE}\n{term_source}").replacen(
             "alias real = f32;",
             &format!("alias real = {};", T::NAME),
             1,
@@ -345,8 +409,13 @@ impl GpuLattice {
             label: Some("stream_collide.wgsl"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
-        // Bindings 0 (the populations) and 7 (the exchanged momenta) are written.
-        let group_layout = bind_group_layout(&device, "lattice", BINDINGS, &[0, 7]);
+        // Bindings 0 (the populations) and 7 and 11 (momenta exchanged) are written.
+        let group_layout = bind_group_layout(
+            &device,
+            "lattice",
+            BINDINGS,
+            &[F as u32, EXCHANGED as u32, COVERED_EXCHANGE as u32],
+        );
         // Group 1 of the observation kernels: binding 0 (the results) is written.
         let observe_layout = bind_group_layout(&device, "observation", OBSERVE_BINDINGS, &[0]);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -374,6 +443,7 @@ impl GpuLattice {
                 ("LES", flag(collider.smagorinsky.is_some())),
                 ("FORCE", flag(collider.force != [0.0, 0.0])),
                 ("LINKS", f64::from(links)),
+                ("COVERED", flag(term.is_some())),
             ];
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
@@ -395,19 +465,13 @@ impl GpuLattice {
                 pipeline("probe", even, &observe_pipeline_layout),
             ]
         });
-        let entries: Vec<wgpu::BindGroupEntry> = buffers
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: b.as_entire_binding(),
-            })
-            .collect();
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("lattice"),
-            layout: &group_layout,
-            entries: &entries,
-        });
+        let bind_group = bind_group(
+            &device,
+            "lattice",
+            &group_layout,
+            &buffers.iter().collect::<Vec<_>>(),
+        );
+        let cover = term.map(|t| covered::DeviceCover::new(&device, t, &buffers[COVERED_INDEX]));
         Ok(GpuLattice {
             device,
             queue: gpu.queue.clone(),
@@ -417,9 +481,10 @@ impl GpuLattice {
             observe_layout,
             observation: RefCell::new(None),
             links,
-            exchanged,
+            buffers,
+            group_layout,
             bind_group,
-            f,
+            cover,
             groups: [(nx as u32).div_ceil(GROUP_X), ny as u32],
             even,
         })
@@ -553,12 +618,12 @@ impl GpuLattice {
 
     /// Copy the device's populations and parity into `lattice` (built like the uploaded one).
     pub fn download<T: Real>(&self, lattice: &mut Lattice<T>) {
-        lattice.set_state(self.read(&self.f), self.even);
+        lattice.set_state(self.read(&self.buffers[F]), self.even);
     }
 
     /// The momentum each obstacle link exchanged in the last step (link order).
     pub fn exchanged<T: Real>(&self) -> Vec<f64> {
-        let m: Vec<T> = self.read(&self.exchanged);
+        let m: Vec<T> = self.read(&self.buffers[EXCHANGED]);
         m[..self.links as usize].iter().map(|v| v.f64()).collect()
     }
 
@@ -566,7 +631,7 @@ impl GpuLattice {
     pub fn upload<T: Real>(&mut self, lattice: &Lattice<T>) {
         let (pops, even) = lattice.state();
         self.queue
-            .write_buffer(&self.f, 0, bytemuck::cast_slice(&pops));
+            .write_buffer(&self.buffers[F], 0, bytemuck::cast_slice(&pops));
         self.even = even;
     }
 }
@@ -588,7 +653,17 @@ impl<T: Real> GpuFluid<T> {
     /// Move `lbm` onto the GPU. Fails with the reason for what the adapter lacks (see
     /// [`GpuLattice::new`]).
     pub fn new(gpu: &Gpu, lbm: Lbm<T>) -> std::result::Result<Self, String> {
-        let device = GpuLattice::new(gpu, &lbm.lattice, &lbm.collider, &lbm.obstacles)?;
+        Self::with_term(gpu, lbm, None)
+    }
+
+    /// Move `lbm` onto the GPU with a coupling's `term` on the cells its solids cover (set
+    /// through [`GpuFluid::lattice_mut`]).
+    pub fn with_term(
+        gpu: &Gpu,
+        lbm: Lbm<T>,
+        term: Option<&CoveredTerm>,
+    ) -> std::result::Result<Self, String> {
+        let device = GpuLattice::new(gpu, &lbm.lattice, &lbm.collider, &lbm.obstacles, term)?;
         Ok(GpuFluid {
             host: RefCell::new(lbm),
             device,
@@ -606,6 +681,16 @@ impl<T: Real> GpuFluid<T> {
         }
         self.refresh_loads();
         self.host.borrow()
+    }
+
+    /// The lattice on the device.
+    pub fn lattice(&self) -> &GpuLattice {
+        &self.device
+    }
+
+    /// The lattice on the device, to change its cover ([`GpuLattice::set_cover`]).
+    pub fn lattice_mut(&mut self) -> &mut GpuLattice {
+        &mut self.device
     }
 
     /// Bring the host copy's obstacle loads up to date (the per-link momenta only come back).

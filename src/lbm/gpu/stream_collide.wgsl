@@ -55,6 +55,14 @@ const OPEN: u32 = 0xffffffffu;
 // Number of obstacle links.
 override LINKS: u32;
 const NONE: u32 = 0xffffffffu;
+// Cells a coupling's solids cover (`lbm::covered`), when COVERED: per cell its entry in the
+// cover (else NONE) …
+override COVERED: bool;
+@group(0) @binding(9) var<storage, read> covered_index: array<u32>;
+// … per entry the values of the coupling's term (`covered_term`, source appended by the host) …
+@group(0) @binding(10) var<storage, read> covered_values: array<real>;
+// … and the momentum the term gave the fluid, summed over the steps since the cover was set.
+@group(0) @binding(11) var<storage, read_write> covered_exchange: array<real>;
 
 const CX = array<i32, 9>(0, 1, 0, -1, 0, 1, -1, -1, 1);
 const CY = array<i32, 9>(0, 0, 1, 0, -1, 1, 1, -1, -1);
@@ -341,6 +349,14 @@ fn stream_collide(@builtin(global_invocation_id) id: vec3<u32>) {
         o = mrt(g);
     } else {
         o = bgk(g);
+    }
+    if (COVERED) {
+        let e = covered_index[c];
+        if (e != NONE) {
+            let dp = covered_term(e, g, &o);
+            covered_exchange[2u * e] += dp.x;
+            covered_exchange[2u * e + 1u] += dp.y;
+        }
     }
     if (EVEN) {
         for (var i = 0u; i < 9u; i++) {

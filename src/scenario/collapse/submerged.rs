@@ -206,7 +206,7 @@ struct FluidFields {
 impl FluidFields {
     /// Refresh the macroscopic fields and ε (from the grains as they are now).
     fn refresh<T: Real>(&mut self, c: &mut Coupled<CoupledFluid<T>, Dem, SlabCover>) {
-        c.fluid.lbm.macroscopic_into(&mut self.m);
+        c.fluid.lbm().macroscopic_into(&mut self.m);
         c.solid.observe(&mut self.view);
         c.map.cover.cover(&self.view, &mut self.cover);
         self.eps.iter_mut().for_each(|e| *e = 0.0);
@@ -414,7 +414,7 @@ impl<T: Real> Column for SubmergedColumn<'_, T> {
         for _ in 0..self.series_steps {
             self.coupled.step()?;
         }
-        Fluid::check_stable(&self.coupled.fluid.lbm, STOP_MACH)
+        Fluid::check_stable(&*self.coupled.fluid.lbm(), STOP_MACH)
     }
     fn tally(&self, _: &Shape) -> Tally {
         let c = &self.coupled;

@@ -93,7 +93,7 @@ fn time<T: Real>(nx: usize, ny: usize, n: usize, steps: u64) -> Result<CoupledBe
         c.step()?;
     }
     let seconds = t0.elapsed().as_secs_f64();
-    crate::lbm::Fluid::check_stable(&c.fluid.lbm, 0.5)?;
+    crate::lbm::Fluid::check_stable(&*c.fluid.lbm(), 0.5)?;
     Ok(CoupledBench {
         mlups: (nx * ny) as f64 * steps as f64 / seconds / 1e6,
         particle_steps_per_s: n as f64 * steps as f64 / seconds,

@@ -11,7 +11,9 @@
 
 use crate::coupling::{Coupled, CoupledFluid, DiskCover, Exchange, Grid, SolidCover};
 use crate::dem::{ContactParams, Dem, DemParams, Grains};
-use crate::lbm::{CollisionModel, Edges, FluidModel, Lattice, Lbm, MrtRates, Obstacles, Real};
+use crate::lbm::{
+    Backend, CollisionModel, Edges, FluidModel, Lattice, Lbm, MrtRates, Obstacles, Real,
+};
 use crate::report::{Check, Fidelity, Plot, Report, Series, MAX_PLOT_POINTS};
 use crate::scenario::fluid::validation::SANGANI_ACRIVOS;
 use crate::units::Units;
@@ -92,7 +94,10 @@ pub fn array_drag<T: Real>(
     let phi_exact = cover.eps.iter().sum::<f64>() / (l * l) as f64;
     let fluid_weight: f64 = (l * l) as f64 - lbm.partial.b.iter().map(|b| b.f64()).sum::<f64>();
     let n = l * l;
-    let mean_u = |f: &CoupledFluid<T>| (0..n).map(|c| f.lbm.cell(c).1).sum::<f64>() / n as f64;
+    let mean_u = |f: &CoupledFluid<T>| {
+        let l = f.lbm();
+        (0..n).map(|c| l.cell(c).1).sum::<f64>() / n as f64
+    };
     let (every, max_steps) = (500, 400_000);
     let (mut u_last, mut steps) = (0.0, 0);
     loop {
@@ -207,7 +212,7 @@ pub fn psm_cylinder_array(fidelity: Fidelity) -> Result<Report> {
 /// Total momentum (SI per unit depth) of fluid + grains of a coupled system (nodes inside
 /// grains under Ladd's bounce-back are not fluid).
 pub fn total_momentum<T: Real, M>(c: &Coupled<CoupledFluid<T>, Dem, M>) -> [f64; 2] {
-    let u = c.fluid.lbm.units;
+    let u = c.fluid.units();
     let k = u.rho0 * u.dx.powi(3) / u.dt;
     let pf = c.fluid.momentum();
     let pg = c.solid.grains.momentum();
@@ -217,25 +222,18 @@ pub fn total_momentum<T: Real, M>(c: &Coupled<CoupledFluid<T>, Dem, M>) -> [f64;
 /// Grains of density ratio 2 moving (and spinning) through a fluid at rest in a periodic
 /// 64 × 64 box without gravity, two of them colliding; `steps` coupled steps.
 /// Returns (initial momentum, largest deviation of the total momentum from it, fluid
-/// momentum at the end).
-pub fn momentum_box<T: Real>(
-    model: CollisionModel,
-    les: Option<f64>,
-    steps: u64,
-) -> Result<([f64; 2], f64, [f64; 2])> {
-    momentum_box_with::<T, _>(model, les, steps, |grid| DiskCover::new(grid, 1.0))
-}
-
-/// [`momentum_box`] with the grains mapped onto the fluid by `map(grid)`.
+/// momentum at the end). The fluid steps on `backend`; the grains are mapped onto it by
+/// `map(grid)`.
 pub fn momentum_box_with<T: Real, M: Exchange<CoupledFluid<T>, Dem>>(
     model: CollisionModel,
     les: Option<f64>,
     steps: u64,
+    backend: Backend,
     map: impl FnOnce(Grid) -> Result<M>,
 ) -> Result<([f64; 2], f64, [f64; 2])> {
     let l = 64;
     let tau = 0.8;
-    let fluid = periodic_fluid::<T>(l, model, tau, les, [0.0; 2])?;
+    let fluid = periodic_fluid::<T>(l, model, tau, les, [0.0; 2])?.on(backend)?;
     let mut g = Grains::new();
     // Areal density 2 (fluid 1), lattice units.
     g.push_disk(20.0, 32.0, 6.0, 2.0);
@@ -271,6 +269,11 @@ pub fn momentum_box_with<T: Real, M: Exchange<CoupledFluid<T>, Dem>>(
 
 /// `coupling-momentum`: fluid + grain momentum in a closed periodic box to 1e-10 relative.
 pub fn momentum(fidelity: Fidelity) -> Result<Report> {
+    momentum_on(fidelity, Backend::Cpu)
+}
+
+/// [`momentum`] with the fluid on `backend`.
+pub fn momentum_on(fidelity: Fidelity, backend: Backend) -> Result<Report> {
     let case = "coupling-momentum";
     let steps = match fidelity {
         Fidelity::Test => 400,
@@ -285,7 +288,9 @@ pub fn momentum(fidelity: Fidelity) -> Result<Report> {
             Some(0.1),
         ),
     ] {
-        let (p0, dev, pf) = momentum_box::<f64>(model, les, steps)?;
+        let (p0, dev, pf) = momentum_box_with::<f64, _>(model, les, steps, backend, |grid| {
+            DiskCover::new(grid, 1.0)
+        })?;
         let p = p0[0].hypot(p0[1]);
         checks.push(Check::at_most(
             case,
@@ -342,14 +347,17 @@ pub struct Settling {
 /// scaling: the same dimensionless problem at every d) until the velocity changes by less
 /// than 1e-4 relative over 0.05 d²/ν, or the disk is 3d above the floor.
 pub fn settling_disk<T: Real>(d: usize, re_f: f64, model: CollisionModel) -> Result<Settling> {
-    settling_disk_with::<T, _>(d, re_f, model, |grid| DiskCover::new(grid, 1.0))
+    settling_disk_with::<T, _>(d, re_f, model, Backend::Cpu, |grid| {
+        DiskCover::new(grid, 1.0)
+    })
 }
 
-/// [`settling_disk`] with the grain mapped onto the fluid by `map(grid)`.
+/// [`settling_disk`] with the fluid on `backend` and the grain mapped onto it by `map(grid)`.
 pub fn settling_disk_with<T: Real, M: Exchange<CoupledFluid<T>, Dem>>(
     d: usize,
     re_f: f64,
     model: CollisionModel,
+    backend: Backend,
     map: impl FnOnce(Grid) -> Result<M>,
 ) -> Result<Settling> {
     let tau = 0.8;
@@ -367,7 +375,8 @@ pub fn settling_disk_with<T: Real, M: Exchange<CoupledFluid<T>, Dem>>(
         },
         Obstacles::default(),
         Units::lattice(tau),
-    ));
+    ))
+    .on(backend)?;
     let a = 0.5 * d as f64;
     let (rho_s, rho_f) = (2.0, 1.0);
     let u_f = re_f * nu / d as f64;
@@ -401,7 +410,7 @@ pub fn settling_disk_with<T: Real, M: Exchange<CoupledFluid<T>, Dem>>(
             c.step()?;
         }
         steps += window;
-        crate::lbm::Fluid::check_stable(&c.fluid.lbm, 0.3)?;
+        crate::lbm::Fluid::check_stable(&*c.fluid.lbm(), 0.3)?;
         let v = -c.solid.grains.vy[0];
         history.push((steps as f64 / t_unit, v / u_f));
         let settled = ((v - last) / v).abs() < 1e-4;
@@ -422,6 +431,11 @@ pub fn settling_disk_with<T: Real, M: Exchange<CoupledFluid<T>, Dem>>(
 /// `settling-disk`: terminal velocity of a disk in a closed channel 4d wide, converging with
 /// resolution and against Faxén's Stokes drag (Re_F = 0.2).
 pub fn settling(fidelity: Fidelity) -> Result<Report> {
+    settling_on(fidelity, Backend::Cpu)
+}
+
+/// [`settling`] with the fluid on `backend`.
+pub fn settling_on(fidelity: Fidelity, backend: Backend) -> Result<Report> {
     let case = "settling-disk";
     let sizes: &[usize] = match fidelity {
         Fidelity::Test => &[10, 20],
@@ -429,7 +443,13 @@ pub fn settling(fidelity: Fidelity) -> Result<Report> {
     };
     let mut runs = Vec::new();
     for &d in sizes {
-        runs.push(settling_disk::<f64>(d, 0.2, CollisionModel::Bgk)?);
+        runs.push(settling_disk_with::<f64, _>(
+            d,
+            0.2,
+            CollisionModel::Bgk,
+            backend,
+            |grid| DiskCover::new(grid, 1.0),
+        )?);
     }
     let mut checks = Vec::new();
     for s in &runs {
@@ -569,7 +589,7 @@ pub fn dkt_run(d_cells: usize, rho_p: f64, tau: f64, t_end: f64) -> Result<Dkt> 
             out.tumble = Some(t);
         }
         if s % every == 0 {
-            crate::lbm::Fluid::check_stable(&c.fluid.lbm, 0.3)?;
+            crate::lbm::Fluid::check_stable(&*c.fluid.lbm(), 0.3)?;
             out.track.push([t, gr.x[0], gr.y[0], gr.x[1], gr.y[1]]);
         }
         if gr.y[0].min(gr.y[1]) < 1.5 * d {

@@ -10,7 +10,7 @@
 
 use crate::coupling::{CellForces, CoupledFluid, Grid, LaddMap, SolidCover};
 use crate::dem::scale::GrainView;
-use crate::lbm::{CollisionModel, FluidModel, Lbm, MrtRates, Real};
+use crate::lbm::{Backend, CollisionModel, FluidModel, Lbm, MrtRates, Real};
 use crate::report::{Check, Fidelity, Plot, Report, Series};
 use crate::scenario::fluid::validation::SANGANI_ACRIVOS;
 use crate::scenario::submerged::validation::{
@@ -67,14 +67,13 @@ pub fn ladd_array_drag<T: Real>(
     };
     let mut cover = SolidCover::default();
     map.cover(&grain, &mut cover);
-    let units = lbm.lbm.units;
-    lbm.ladd.set(&mut lbm.lbm.lattice, &cover.links, &units);
+    lbm.set_links(&cover.links)?;
     let n = l * l;
     let n_inside = cover.links.inside.len();
     let mean_u = |f: &CoupledFluid<T>| {
         (0..n)
             .filter(|&c| !f.ladd.is_inside(c))
-            .map(|c| f.lbm.cell(c).1)
+            .map(|c| f.lbm().cell(c).1)
             .sum::<f64>()
             / n as f64
     };
@@ -204,8 +203,11 @@ pub fn settling(fidelity: Fidelity) -> Result<Report> {
         Fidelity::Test => &[10, 20],
         Fidelity::Full => &[10, 20, 40],
     };
-    let ladd =
-        |d| settling_disk_with::<f64, _>(d, 0.2, CollisionModel::Bgk, |g| LaddMap::new(g, 1.0));
+    let ladd = |d| {
+        settling_disk_with::<f64, _>(d, 0.2, CollisionModel::Bgk, Backend::Cpu, |g| {
+            LaddMap::new(g, 1.0)
+        })
+    };
     let runs: Vec<Settling> = sizes.iter().map(|&d| ladd(d)).collect::<Result<_>>()?;
     let psm = settling_disk::<f64>(20, 0.2, CollisionModel::Bgk)?;
     let mut checks = Vec::new();
@@ -297,7 +299,7 @@ pub fn momentum(fidelity: Fidelity) -> Result<Report> {
         ),
     ] {
         let (p0, dev, pf) =
-            momentum_box_with::<f64, _>(model, les, steps, |g| LaddMap::new(g, 1.0))?;
+            momentum_box_with::<f64, _>(model, les, steps, Backend::Cpu, |g| LaddMap::new(g, 1.0))?;
         let p = p0[0].hypot(p0[1]);
         // With the covering/uncovering impulses every momentum the fluid loses or gains is
         // the grains': round-off, gated as for PSM at 1e-10.
@@ -317,9 +319,10 @@ pub fn momentum(fidelity: Fidelity) -> Result<Report> {
     // Seed eq. 5.45–5.49 alone (no impulses): momentum appears and disappears with the nodes
     // the grains cover and uncover. Reported; it must be well above round-off, else the
     // impulses would be idle.
-    let (p0, dev, _) = momentum_box_with::<f64, _>(CollisionModel::Bgk, None, steps, |g| {
-        Ok(LaddMap::new(g, 1.0)?.with_impulses(false))
-    })?;
+    let (p0, dev, _) =
+        momentum_box_with::<f64, _>(CollisionModel::Bgk, None, steps, Backend::Cpu, |g| {
+            Ok(LaddMap::new(g, 1.0)?.with_impulses(false))
+        })?;
     let rel = dev / p0[0].hypot(p0[1]);
     checks.push(Check::report(
         case,
@@ -399,7 +402,7 @@ where
         }
         g.x[0] += u;
     }
-    crate::lbm::Fluid::check_stable(&lbm.lbm, 0.3)?;
+    crate::lbm::Fluid::check_stable(&*lbm.lbm(), 0.3)?;
     let mean = f.iter().sum::<f64>() / f.len() as f64;
     let var = f.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / f.len() as f64;
     Ok((mean, var.sqrt()))

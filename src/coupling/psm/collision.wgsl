@@ -1,0 +1,35 @@
+// The partially saturated blend of `coupling::psm::collision` on the GPU, as the covered
+// cells' term of the lattice kernel (`lbm::gpu::CoveredTerm`). Entry e of the cover carries
+// covered_values[3e..3e+3] = (B, u_s,x, u_s,y) in lattice units.
+//
+// f_i* = (1 − B) C(f)_i + B (f_i + Ω_i^s), Ω_i^s = [f_ī − f_ī^eq(ρ, u)] − [f_i − f_i^eq(ρ, u_s)],
+// with u = (Σ f e + F/2)/ρ; returns the momentum B Σ_i Ω_i^s e_i the solid term gave the fluid.
+//
+// Written as Ω_i^s = (f_ī − f_i) + w_i ρ [3 e_i·(u_s + u) + 4.5 ((e_i·u_s)² − (e_i·u)²)
+// − 1.5 (|u_s|² − |u|²)]: the two equilibria's common w_i ρ cancels by hand, so in f32 the
+// term keeps the digits that the CPU keeps by blending in f64.
+fn covered_term(e: u32, g: array<real, 9>, post: ptr<function, array<real, 9>>) -> vec2<real> {
+    let b = covered_values[3u * e];
+    let sx = covered_values[3u * e + 1u];
+    let sy = covered_values[3u * e + 2u];
+    let fx = select(0.0, coef[3], FORCE);
+    let fy = select(0.0, coef[4], FORCE);
+    let rho = g[0] + g[1] + g[2] + g[3] + g[4] + g[5] + g[6] + g[7] + g[8];
+    let jx = g[1] - g[3] + g[5] - g[6] - g[7] + g[8];
+    let jy = g[2] - g[4] + g[5] + g[6] - g[7] - g[8];
+    let ux = (jx + 0.5 * fx) / rho;
+    let uy = (jy + 0.5 * fy) / rho;
+    let du2 = 1.5 * ((sx * sx + sy * sy) - (ux * ux + uy * uy));
+    var dp = vec2<real>(0.0, 0.0);
+    for (var i = 0u; i < 9u; i++) {
+        let cx = real(CX[i]);
+        let cy = real(CY[i]);
+        let w = select(select(W5, W1, i < 5u), W0, i == 0u);
+        let cu = cx * ux + cy * uy;
+        let cs = cx * sx + cy * sy;
+        let omega = (g[OPP[i]] - g[i]) + w * rho * (3.0 * (cs + cu) + 4.5 * (cs * cs - cu * cu) - du2);
+        (*post)[i] = (1.0 - b) * (*post)[i] + b * (g[i] + omega);
+        dp += b * omega * vec2<real>(cx, cy);
+    }
+    return dp;
+}

@@ -40,8 +40,8 @@ enum Command {
         /// repeat for more); the output folder's scenario.toml records it.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<Override>,
-        /// Where a fluid file's lattice steps (kind = "fluid"; the same as --set
-        /// lbm.backend=…; gpu needs a build with --features gpu).
+        /// Where the lattice steps: of a fluid file (the same as --set lbm.backend=…) or a
+        /// submerged one (--set coupling.backend=…); gpu needs a build with --features gpu.
         #[arg(long, value_enum)]
         backend: Option<Backend>,
         /// Output folder (created if needed; one that holds an earlier run is refused unless
@@ -375,6 +375,9 @@ pub(crate) enum Bench {
         /// Population precision.
         #[arg(long, value_enum, default_value_t = Precision::F32)]
         precision: Precision,
+        /// Where the lattice steps (the grains step on the CPU).
+        #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+        backend: Backend,
         /// Threads (0: all cores).
         #[arg(long, default_value_t = 0)]
         threads: usize,
@@ -438,9 +441,7 @@ fn real_main() -> Result<ExitCode> {
             checkpoint_every,
         } => {
             if let Some(b) = backend {
-                let name = granflow::lbm::Backend::from(b).name();
-                let key = format!("lbm.backend=\"{name}\"");
-                set.push(key.parse().map_err(anyhow::Error::msg)?);
+                set.push(cli::run::backend_override(&scenario, b.into())?);
             }
             cli::run::run(
                 &scenario,

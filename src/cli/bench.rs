@@ -127,23 +127,27 @@ pub fn bench(which: Bench) -> Result<ExitCode> {
             grains,
             steps,
             precision,
+            backend,
             threads,
             json,
         } => {
             let r = granflow::scenario::submerged::bench::coupled(
-                nx,
-                ny,
-                grains,
-                steps,
-                matches!(precision, Precision::F64),
+                granflow::scenario::submerged::bench::CoupledCase {
+                    nx,
+                    ny,
+                    grains,
+                    steps,
+                    f64: matches!(precision, Precision::F64),
+                    backend: backend.into(),
+                },
                 threads,
             )?;
             if json {
                 println!("{}", serde_json::to_string(&r)?);
             } else {
                 println!(
-                    "coupled {}×{} {} with {} grains on {} threads: {:.1} MLUPS, {:.3e} grain steps/s, {:.2} s for {} steps ({} covered cells, {} DEM sub-steps per fluid step)",
-                    r.nx, r.ny, r.precision, r.grains, r.threads, r.mlups, r.particle_steps_per_s, r.seconds, r.steps, r.covered_cells, r.subcycles
+                    "coupled {}×{} {} with {} grains, lattice on the {}, {} threads: {:.1} MLUPS, {:.3e} grain steps/s, {:.2} s for {} steps ({} covered cells, {} DEM sub-steps per fluid step)",
+                    r.nx, r.ny, r.precision, r.grains, r.backend, r.threads, r.mlups, r.particle_steps_per_s, r.seconds, r.steps, r.covered_cells, r.subcycles
                 );
             }
             Ok(ExitCode::SUCCESS)

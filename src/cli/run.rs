@@ -48,6 +48,24 @@ pub fn check(path: &Path, sets: &[Override]) -> Result<ExitCode> {
 
 /// The kind and text of the scenario file at `path`, with the keys `--set` changes; a sweep
 /// file takes none.
+/// The key `--backend` sets in the scenario `path`: `lbm.backend` of a fluid file,
+/// `coupling.backend` of a submerged one; other kinds have no lattice.
+pub fn backend_override(path: &Path, backend: granflow::lbm::Backend) -> Result<Override> {
+    let (kind, _) = granflow::scenario::read_file(path, &[])?;
+    let section = match kind {
+        Kind::Fluid => "lbm",
+        Kind::Submerged => "coupling",
+        other => anyhow::bail!(
+            "--backend: {} is a {} scenario, which has no lattice (only fluid and submerged \
+             files do)",
+            path.display(),
+            other.name()
+        ),
+    };
+    let key = format!("{section}.backend=\"{}\"", backend.name());
+    key.parse().map_err(anyhow::Error::msg)
+}
+
 fn read_scenario(path: &Path, sets: &[Override]) -> Result<(Kind, String)> {
     let (kind, text) = granflow::scenario::read_file(path, sets)?;
     if kind == Kind::Sweep && !sets.is_empty() {

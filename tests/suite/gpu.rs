@@ -425,21 +425,27 @@ fn observations_are_reduced_on_the_device_as_on_the_cpu() {
 
 /// Grains in the fluid: the partially saturated cells blended on the device (the kernel's
 /// covered-cells term) against the CPU, coupled step for coupled step. Three grains move and
-/// spin through a periodic box with a body force, two of them colliding; after an odd number
+/// spin through a box with a body force, periodic or walled (where the third grain's cover
+/// reaches the wall nodes), two of them colliding; after an odd number
 /// of coupled steps (both parities) the populations, the grains' velocities and the force on
 /// each covered cell agree. The device computes Ω^s with the equilibria's common part cancelled
 /// by hand in its own precision, the CPU in f64 from the populations. Gates about ten times the
-/// worst measured on lavapipe (BGK and MRT, 301 coupled steps): f32, populations 3.0e-7,
-/// grain velocities 1.7e-5 and cell forces 2.5e-4 (each relative to the largest); f64,
-/// 1.6e-15, 2.4e-14 and 5.8e-13.
-fn coupled_difference<T: Real>(gpu_model: CollisionModel) -> (f64, f64, f64) {
+/// worst measured on lavapipe (the three cases, 301 coupled steps): f32, populations 3.6e-7,
+/// grain velocities 2.6e-5 and cell forces 4.4e-4 (each relative to the largest); f64,
+/// 1.6e-15, 3.1e-14 and 1.1e-12.
+fn coupled_difference<T: Real>(gpu_model: CollisionModel, walls: bool) -> (f64, f64, f64) {
     use granflow::coupling::{CellForces, Coupled, CoupledFluid, DiskCover, Grid};
     use granflow::dem::{ContactParams, Dem, DemParams, Grains};
     use granflow::lbm::{Backend, Lattice, Obstacles};
     use granflow::scale::Scale;
     let l = 48;
     let run = |backend: Backend| {
-        let lat = Lattice::<T>::new(l, l, Edges::periodic(), vec![false; l * l]).unwrap();
+        let edges = if walls {
+            Edges::closed()
+        } else {
+            Edges::periodic()
+        };
+        let lat = Lattice::<T>::new(l, l, edges, vec![false; l * l]).unwrap();
         let lbm = Lbm::new(
             lat,
             FluidModel {
@@ -454,7 +460,7 @@ fn coupled_difference<T: Real>(gpu_model: CollisionModel) -> (f64, f64, f64) {
         let mut g = Grains::new();
         g.push_disk(14.0, 24.0, 5.0, 2.0);
         g.push_disk(30.0, 25.0, 5.0, 2.0);
-        g.push_disk(24.0, 9.0, 4.2, 2.0);
+        g.push_disk(24.0, 5.0, 4.2, 2.0);
         (g.vx[0], g.vx[1], g.vy[2], g.omega[2]) = (0.02, -0.01, 0.015, 0.004);
         let elastic = ContactParams::elastic(50.0);
         let dem = Dem::new(g, Vec::new(), DemParams::new(elastic, elastic, [0.0; 2])).unwrap();
@@ -462,7 +468,7 @@ fn coupled_difference<T: Real>(gpu_model: CollisionModel) -> (f64, f64, f64) {
             nx: l,
             ny: l,
             dx: 1.0,
-            periodic: [true, true],
+            periodic: [!walls; 2],
         };
         let mut c = Coupled::new(fluid, dem, DiskCover::new(grid, 1.0).unwrap());
         for _ in 0..STEPS {
@@ -495,16 +501,20 @@ fn coupled_difference<T: Real>(gpu_model: CollisionModel) -> (f64, f64, f64) {
 fn grains_couple_on_the_device_as_on_the_cpu() {
     let Some(gpu) = gpu() else { return };
     let mrt = CollisionModel::Mrt(MrtRates::standard(0.8));
-    for (name, model) in [("BGK", CollisionModel::Bgk), ("MRT", mrt)] {
-        let (f, v, force) = coupled_difference::<f32>(model);
+    for (name, model, walls) in [
+        ("BGK periodic", CollisionModel::Bgk, false),
+        ("MRT periodic", mrt, false),
+        ("BGK walls", CollisionModel::Bgk, true),
+    ] {
+        let (f, v, force) = coupled_difference::<f32>(model, walls);
         println!(
             "PSM f32 {name}: max |Δf| {f:.3e}, grain velocities {v:.3e}, cell forces {force:.3e}"
         );
-        assert!(f < 3e-6 && v < 2e-4 && force < 3e-3, "f32 {name}");
+        assert!(f < 4e-6 && v < 3e-4 && force < 5e-3, "f32 {name}");
         if gpu.f64 {
-            let (f, v, force) = coupled_difference::<f64>(model);
+            let (f, v, force) = coupled_difference::<f64>(model, walls);
             println!("PSM f64 {name}: max |Δf| {f:.3e}, grain velocities {v:.3e}, cell forces {force:.3e}");
-            assert!(f < 2e-14 && v < 3e-13 && force < 6e-12, "f64 {name}");
+            assert!(f < 2e-14 && v < 3e-13 && force < 2e-11, "f64 {name}");
         }
     }
 }

@@ -555,7 +555,9 @@ fn assemble<'a, T: Real>(
         },
         Obstacles::default(),
         u,
-    ));
+    ))
+    .on(scenario.coupling.backend)
+    .map_err(|e| Error::config("coupling.backend", e.to_string()))?;
     let grid = Grid {
         nx,
         ny,

@@ -3,9 +3,11 @@
 //! An `nx × ny` box (periodic in x, walls at the bottom and top) with `grains` disks on a
 //! square grid of spacing s = √(nx·ny/N), radius 0.4 s (about half the cells covered, no
 //! contacts at the start), density ratio 2.65 (quartz in water), without gravity and moving
-//! with velocities up to 1 cm/s (lattice 0.033) in varied directions, spinning. Timed over `steps` coupled steps after two warm-up steps; reports lattice updates
-//! per second (MLUPS), grain steps per second (one per grain per coupled step, however many
-//! DEM sub-steps it takes) and the wall time.
+//! with velocities up to 1 cm/s (lattice 0.033) in varied directions, spinning. Timed over
+//! `steps` coupled steps after two warm-up steps; reports lattice updates per second (MLUPS),
+//! grain steps per second (one per grain per coupled step, however many DEM sub-steps it
+//! takes) and the wall time. With the lattice on a GPU (`--backend gpu`) each coupled step
+//! uploads the covered cells and reads their forces back; the grains step on the CPU.
 
 use std::time::Instant;
 
@@ -13,7 +15,7 @@ use serde::Serialize;
 
 use crate::coupling::{Coupled, CoupledFluid, DiskCover, Grid};
 use crate::dem::{ContactParams, Dem, DemParams, Grains};
-use crate::lbm::{CollisionModel, Edges, FluidModel, Lattice, Lbm, Obstacles, Real};
+use crate::lbm::{Backend, CollisionModel, Edges, FluidModel, Lattice, Lbm, Obstacles, Real};
 use crate::units::Units;
 use crate::{Error, Result};
 
@@ -42,9 +44,36 @@ pub struct CoupledBench {
     pub threads: usize,
     /// `"f32"` or `"f64"`.
     pub precision: String,
+    /// Where the lattice stepped: `"cpu"` or `"gpu"`.
+    pub backend: String,
 }
 
-fn time<T: Real>(nx: usize, ny: usize, n: usize, steps: u64) -> Result<CoupledBench> {
+/// What `granflow bench coupled` times.
+#[derive(Clone, Copy, Debug)]
+pub struct CoupledCase {
+    /// Cells along x.
+    pub nx: usize,
+    /// Cells along y.
+    pub ny: usize,
+    /// Grains.
+    pub grains: usize,
+    /// Coupled steps timed.
+    pub steps: u64,
+    /// f64 populations (else f32).
+    pub f64: bool,
+    /// Where the lattice steps.
+    pub backend: Backend,
+}
+
+fn time<T: Real>(case: CoupledCase) -> Result<CoupledBench> {
+    let CoupledCase {
+        nx,
+        ny,
+        grains: n,
+        steps,
+        backend,
+        ..
+    } = case;
     let lat =
         Lattice::<T>::new(nx, ny, Edges::channel(), vec![false; nx * ny]).map_err(Error::Other)?;
     // SI: Δx = 0.1 mm, water, τ = 0.6.
@@ -60,7 +89,8 @@ fn time<T: Real>(nx: usize, ny: usize, n: usize, steps: u64) -> Result<CoupledBe
         },
         Obstacles::default(),
         units,
-    ));
+    ))
+    .on(backend)?;
     let s = ((nx * ny) as f64 / n as f64).sqrt();
     let per_row = ((nx as f64 / s).floor() as usize).max(1);
     let mut g = Grains::with_capacity(n);
@@ -106,18 +136,19 @@ fn time<T: Real>(nx: usize, ny: usize, n: usize, steps: u64) -> Result<CoupledBe
         subcycles: c.last_subcycles,
         threads: rayon::current_num_threads(),
         precision: T::NAME.into(),
+        backend: backend.name().into(),
     })
 }
 
 /// Run the coupled benchmark on `threads` threads (0: rayon's default).
-pub fn coupled(
-    nx: usize,
-    ny: usize,
-    grains: usize,
-    steps: u64,
-    f64_: bool,
-    threads: usize,
-) -> Result<CoupledBench> {
+pub fn coupled(case: CoupledCase, threads: usize) -> Result<CoupledBench> {
+    let CoupledCase {
+        nx,
+        ny,
+        grains,
+        steps,
+        ..
+    } = case;
     if nx < 3 || ny < 3 || grains == 0 || steps == 0 {
         return Err(Error::Other(
             "bench coupled: need nx, ny ≥ 3 and grains, steps ≥ 1".into(),
@@ -130,10 +161,10 @@ pub fn coupled(
         )));
     }
     crate::exec::on_threads(threads, || {
-        if f64_ {
-            time::<f64>(nx, ny, grains, steps)
+        if case.f64 {
+            time::<f64>(case)
         } else {
-            time::<f32>(nx, ny, grains, steps)
+            time::<f32>(case)
         }
     })
 }

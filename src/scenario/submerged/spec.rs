@@ -120,6 +120,11 @@ pub struct CouplingSpec {
     pub mrt: Option<MrtSpec>,
     /// Smagorinsky constant C_s (seed eq. 5.38); absent: no LES.
     pub smagorinsky: Option<f64>,
+    /// Where the lattice steps: `"cpu"` (the default) or `"gpu"` (a build with the `gpu`
+    /// feature; the partially saturated cells are blended on the device, the grains step on
+    /// the CPU; `method = "psm"` only; f64 needs an adapter with SHADER_F64).
+    #[serde(default)]
+    pub backend: crate::lbm::Backend,
 }
 
 /// What [`SubmergedScenario::derive`] computes.
@@ -190,6 +195,16 @@ impl SubmergedScenario {
         let dem = self.dem_part().derive()?;
         let f = &self.fluid;
         let c = &self.coupling;
+        c.backend
+            .check()
+            .map_err(|e| Error::config("coupling.backend", e))?;
+        if c.backend == crate::lbm::Backend::Gpu && c.method == CouplingMethod::Ladd {
+            return Err(Error::config(
+                "coupling.backend",
+                "Ladd's bounce-back runs on the CPU only: use backend = \"cpu\", or \
+                 method = \"psm\" on the GPU",
+            ));
+        }
         positive("fluid.density", f.density)?;
         positive("fluid.viscosity", f.viscosity)?;
         positive("fluid.depth", f.depth)?;

@@ -51,11 +51,13 @@ pub struct CellForces {
     pub links: LinkForces,
 }
 
-/// The lattice of a coupled fluid, on the back end it steps on.
+/// The lattice of a coupled fluid, on the back end it steps on (one per fluid: the variants'
+/// sizes do not matter).
+#[allow(clippy::large_enum_variant)]
 enum Lattices<T> {
     Cpu(Lbm<T>),
     #[cfg(feature = "gpu")]
-    Gpu(Box<crate::lbm::gpu::GpuFluid<T>>),
+    Gpu(crate::lbm::gpu::GpuFluid<T>),
 }
 
 /// The fluid's solver as it stands ([`CoupledFluid::lbm`]).
@@ -133,7 +135,7 @@ impl<T: Real> CoupledFluid<T> {
                 let dev = crate::lbm::gpu::GpuFluid::with_term(&gpu, lbm, Some(&term))
                     .map_err(Error::Other)?;
                 let mut moved = CoupledFluid {
-                    fluid: Lattices::Gpu(Box::new(dev)),
+                    fluid: Lattices::Gpu(dev),
                     ..self
                 };
                 moved.upload_cover();
@@ -166,7 +168,7 @@ impl<T: Real> CoupledFluid<T> {
         match &self.fluid {
             Lattices::Cpu(l) => l.units,
             #[cfg(feature = "gpu")]
-            Lattices::Gpu(g) => crate::lbm::Fluid::units(g.as_ref()),
+            Lattices::Gpu(g) => crate::lbm::Fluid::units(g),
         }
     }
 
@@ -191,7 +193,7 @@ impl<T: Real> CoupledFluid<T> {
         match &mut self.fluid {
             Lattices::Cpu(l) => l.set_state(s.lbm)?,
             #[cfg(feature = "gpu")]
-            Lattices::Gpu(g) => crate::lbm::Fluid::set_state(g.as_mut(), s.lbm)?,
+            Lattices::Gpu(g) => crate::lbm::Fluid::set_state(g, s.lbm)?,
         }
         self.partial = s.partial;
         self.exchange = s.exchange;
@@ -247,7 +249,7 @@ impl<T: Real> CoupledFluid<T> {
                 });
             }
             #[cfg(feature = "gpu")]
-            Lattices::Gpu(g) => crate::lbm::Fluid::steps(g.as_mut(), 1),
+            Lattices::Gpu(g) => crate::lbm::Fluid::steps(g, 1),
         }
     }
 
@@ -319,7 +321,7 @@ impl<T: Real> Scale for CoupledFluid<T> {
         let steps = match &self.fluid {
             Lattices::Cpu(l) => l.steps,
             #[cfg(feature = "gpu")]
-            Lattices::Gpu(g) => crate::lbm::Fluid::step_count(g.as_ref()),
+            Lattices::Gpu(g) => crate::lbm::Fluid::step_count(g),
         };
         steps as f64 * self.units().dt
     }
@@ -383,7 +385,7 @@ impl<T: Real> Scale for CoupledFluid<T> {
         let restored = match &mut self.fluid {
             Lattices::Cpu(l) => l.set_state(s),
             #[cfg(feature = "gpu")]
-            Lattices::Gpu(g) => crate::lbm::Fluid::set_state(g.as_mut(), s),
+            Lattices::Gpu(g) => crate::lbm::Fluid::set_state(g, s),
         };
         restored.expect("a snapshot of this fluid restores into it");
     }

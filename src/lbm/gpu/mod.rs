@@ -21,8 +21,9 @@
 //! [`super::boundary`] on the nodes the CPU plan marks, in the kernel's precision), obstacles
 //! (half-way or Yu's interpolated bounce-back: a second kernel over the links after each step,
 //! which also stores the momentum each link exchanged; the loads are summed on the host in link
-//! order when observed, as the CPU sums them), in f32, and in f64 where the adapter offers
-//! `SHADER_F64`.
+//! order when observed, as the CPU sums them), a coupling method's term on the cells its solids
+//! cover (`covered.rs`: the partially saturated cells), in f32, and in f64 where the adapter
+//! offers `SHADER_F64`.
 
 use std::cell::{Cell, Ref, RefCell};
 

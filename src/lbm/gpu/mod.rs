@@ -379,7 +379,7 @@ impl GpuLattice {
         };
         let copy = wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let read = wgpu::BufferUsages::empty();
-        let cells = nx * ny;
+        let (cells, real) = (nx * ny, std::mem::size_of::<T>());
         let buffers = vec![
             storage("populations", bytemuck::cast_slice(&pops), copy),
             storage("kind", bytemuck::cast_slice(&kind), read),
@@ -397,8 +397,8 @@ impl GpuLattice {
                 bytemuck::cast_slice(&vec![u32::MAX; if term.is_some() { cells } else { 1 }]),
                 read,
             ),
-            zeroed(&device, "covered values", 4, copy),
-            zeroed(&device, "covered exchange", 4, copy),
+            zeroed(&device, "covered values", real, copy),
+            zeroed(&device, "covered exchange", real, copy),
         ];
         let term_source = term.map_or(covered::NO_TERM, |t| t.source);
         let source = format!("{SOURCE}\n{term_source}").replacen(

@@ -505,3 +505,42 @@ fn polygon_grains_are_refused() {
     let err = s.derive().unwrap_err().to_string();
     assert!(err.contains("grains.sides"), "{err}");
 }
+
+/// `coupling.backend = "gpu"` is refused, naming the key: with Ladd's links (CPU only) in a
+/// GPU build, and in a build without the GPU back end with the rebuild that gives it.
+#[test]
+fn gpu_backend_is_refused_where_it_cannot_run() {
+    use granflow::lbm::Backend;
+    use granflow::scenario::submerged::spec::CouplingMethod;
+    let mut s = tiny();
+    s.coupling.backend = Backend::Gpu;
+    s.coupling.method = CouplingMethod::Ladd;
+    let err = s.derive().unwrap_err().to_string();
+    let reason = if cfg!(feature = "gpu") {
+        "CPU only"
+    } else {
+        "--features gpu"
+    };
+    assert!(
+        err.contains("coupling.backend") && err.contains(reason),
+        "{err}"
+    );
+}
+
+/// `run --backend` sets the key of the file's kind, and refuses a kind without a lattice.
+#[test]
+fn run_backend_is_refused_for_a_file_without_a_lattice() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/column_collapse/dem_a2.toml");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_granflow"))
+        .args(["run", model.to_str().unwrap(), "--backend", "cpu", "--out"])
+        .arg(dir.path().join("run"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("--backend") && err.contains("no lattice"),
+        "{err}"
+    );
+    assert!(!dir.path().join("run").exists());
+}

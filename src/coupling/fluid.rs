@@ -80,6 +80,9 @@ impl<T> Deref for LbmRef<'_, T> {
     }
 }
 
+/// Momentum exchanged per covered cell summed over the steps of an advance, and their number.
+type ExchangeSum = (Vec<[f64; 2]>, u64);
+
 /// The LBM and the state of the coupling methods between it and the solids.
 pub struct CoupledFluid<T> {
     /// The fluid.
@@ -93,7 +96,7 @@ pub struct CoupledFluid<T> {
     /// Momentum exchanged per covered cell summed over the steps of the last
     /// [`Scale::advance`], and their number (the sum is kept only for more than one step;
     /// for one, [`CoupledFluid::exchange`] is that step's).
-    exchange_sum: (Vec<[f64; 2]>, u64),
+    exchange_sum: ExchangeSum,
     /// Boundary links of moving solids under Ladd's bounce-back (empty: none).
     pub ladd: BounceLinks,
 }
@@ -106,7 +109,7 @@ pub struct CoupledFluidState<T> {
     lbm: LbmState,
     partial: PartialCells<T>,
     exchange: Vec<[f64; 2]>,
-    exchange_sum: (Vec<[f64; 2]>, u64),
+    exchange_sum: ExchangeSum,
     ladd: BounceLinks,
 }
 
@@ -123,26 +126,38 @@ impl<T: Real> CoupledFluid<T> {
     }
 
     /// The same fluid on `backend`: on `gpu` its populations move to the device, which then
-    /// also blends the covered cells. Fails with the reason when the back end is not built,
-    /// finds no adapter or lacks something the fluid uses.
+    /// also blends the covered cells; back on `cpu` they come home. Fails with the reason when
+    /// the back end is not built, finds no adapter or lacks something the fluid uses.
     pub fn on(self, backend: Backend) -> Result<Self> {
         backend.check().map_err(Error::Other)?;
-        match (backend, self.fluid) {
+        if backend == self.backend() {
+            return Ok(self);
+        }
+        let (exchange, exchange_sum) = self.exchange_state();
+        // One arm in a build without the GPU back end.
+        #[allow(clippy::infallible_destructuring_match)]
+        let lbm = match self.fluid {
+            Lattices::Cpu(l) => l,
             #[cfg(feature = "gpu")]
-            (Backend::Gpu, Lattices::Cpu(lbm)) => {
+            Lattices::Gpu(g) => g.into_host(),
+        };
+        let fluid = match backend {
+            Backend::Cpu => Lattices::Cpu(lbm),
+            #[cfg(feature = "gpu")]
+            Backend::Gpu => {
                 let gpu = crate::lbm::gpu::Gpu::new().map_err(Error::Other)?;
                 let term = super::psm::collision::DEVICE_TERM;
-                let dev = crate::lbm::gpu::GpuFluid::with_term(&gpu, lbm, Some(&term))
-                    .map_err(Error::Other)?;
-                let mut moved = CoupledFluid {
-                    fluid: Lattices::Gpu(dev),
-                    ..self
-                };
-                moved.upload_cover();
-                Ok(moved)
+                Lattices::Gpu(
+                    crate::lbm::gpu::GpuFluid::with_term(&gpu, lbm, Some(&term))
+                        .map_err(Error::Other)?,
+                )
             }
-            (_, fluid) => Ok(CoupledFluid { fluid, ..self }),
-        }
+            #[cfg(not(feature = "gpu"))]
+            Backend::Gpu => unreachable!("refused by Backend::check"),
+        };
+        let mut moved = CoupledFluid { fluid, ..self };
+        moved.set_exchange(exchange, exchange_sum);
+        Ok(moved)
     }
 
     /// The back end the lattice steps on.
@@ -174,11 +189,7 @@ impl<T: Real> CoupledFluid<T> {
 
     /// A copy of the state that changes as it runs.
     pub fn state(&self) -> CoupledFluidState<T> {
-        let (exchange, exchange_sum) = match self.exchange_sums() {
-            (sums, 1) => (sums.into_owned(), (Vec::new(), self.exchange_sum.1)),
-            // The last step's own exchange is not needed to continue.
-            (sums, k) => (self.exchange.clone(), (sums.into_owned(), k)),
-        };
+        let (exchange, exchange_sum) = self.exchange_state();
         CoupledFluidState {
             lbm: self.lbm().state(),
             partial: self.partial.clone(),
@@ -196,20 +207,34 @@ impl<T: Real> CoupledFluid<T> {
             Lattices::Gpu(g) => crate::lbm::Fluid::set_state(g, s.lbm)?,
         }
         self.partial = s.partial;
-        self.exchange = s.exchange;
-        self.exchange_sum = s.exchange_sum;
         self.ladd = s.ladd;
+        self.set_exchange(s.exchange, s.exchange_sum);
+        Ok(())
+    }
+
+    /// [`CoupledFluid::exchange`] and the exchange sum as the CPU keeps them (from the device's
+    /// sums on a GPU; the last step's own exchange is not needed to continue a sum).
+    fn exchange_state(&self) -> (Vec<[f64; 2]>, ExchangeSum) {
+        match self.exchange_sums() {
+            (sums, 1) => (sums.into_owned(), (Vec::new(), self.exchange_sum.1)),
+            (sums, k) => (self.exchange.clone(), (sums.into_owned(), k)),
+        }
+    }
+
+    /// Set what [`CoupledFluid::exchange_state`] returned, with the cover of
+    /// [`CoupledFluid::partial`] (on a GPU both go to the device, which holds the sums).
+    fn set_exchange(&mut self, exchange: Vec<[f64; 2]>, exchange_sum: ExchangeSum) {
+        self.exchange = exchange;
+        self.exchange_sum = exchange_sum;
         self.upload_cover();
         #[cfg(feature = "gpu")]
         if let Lattices::Gpu(g) = &mut self.fluid {
-            // The device holds the sums over the steps of the advance.
             let sums = match self.exchange_sum.1 {
                 0 | 1 => &self.exchange,
                 _ => &self.exchange_sum.0,
             };
             g.lattice_mut().set_covered_exchange::<T>(sums);
         }
-        Ok(())
     }
 
     /// The momentum each covered cell's solid term gave the fluid (lattice units), summed

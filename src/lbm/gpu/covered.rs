@@ -196,11 +196,12 @@ impl GpuLattice {
             .collect()
     }
 
-    /// Overwrite the sums [`GpuLattice::covered_exchange`] returns (to continue a run).
+    /// Overwrite the sums [`GpuLattice::covered_exchange`] returns (to continue a run): those
+    /// of the first entries, in entry order (the others stay as [`GpuLattice::set_cover`] left
+    /// them, zero).
     pub fn set_covered_exchange<T: Real>(&mut self, sums: &[[f64; 2]]) {
-        let n = self.cover.as_ref().map_or(0, |c| c.entries);
-        assert_eq!(sums.len(), n, "one sum per covered cell");
-        let values: Vec<T> = sums.iter().flatten().map(|&v| T::c(v)).collect();
+        let n = self.cover.as_ref().map_or(0, |c| c.entries).min(sums.len());
+        let values: Vec<T> = sums[..n].iter().flatten().map(|&v| T::c(v)).collect();
         if n > 0 {
             self.queue.write_buffer(
                 &self.buffers[COVERED_EXCHANGE],

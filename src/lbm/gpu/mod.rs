@@ -684,6 +684,12 @@ impl<T: Real> GpuFluid<T> {
         self.host.borrow()
     }
 
+    /// The solver back on the host, up to date.
+    pub fn into_host(self) -> Lbm<T> {
+        drop(self.host());
+        self.host.into_inner()
+    }
+
     /// The lattice on the device.
     pub fn lattice(&self) -> &GpuLattice {
         &self.device

@@ -91,7 +91,7 @@ pub struct CoupledFluid<T> {
     pub partial: PartialCells<T>,
     /// Momentum the solid term gave the fluid at each covered cell in the last step (lattice
     /// units), in the order of [`PartialCells::cells`]; the force on the solid is its negative.
-    /// On a GPU it stays on the device: see [`CoupledFluid::exchanged`].
+    /// On a GPU the device keeps the sums instead (read back by [`Scale::observe`]).
     pub exchange: Vec<[f64; 2]>,
     /// Momentum exchanged per covered cell summed over the steps of the last
     /// [`Scale::advance`], and their number (the sum is kept only for more than one step;
@@ -201,15 +201,20 @@ impl<T: Real> CoupledFluid<T> {
 
     /// Continue from a state taken by [`CoupledFluid::state`] of a fluid built the same way.
     pub fn set_state(&mut self, s: CoupledFluidState<T>) -> Result<()> {
-        match &mut self.fluid {
-            Lattices::Cpu(l) => l.set_state(s.lbm)?,
-            #[cfg(feature = "gpu")]
-            Lattices::Gpu(g) => crate::lbm::Fluid::set_state(g, s.lbm)?,
-        }
+        self.set_lbm_state(s.lbm)?;
         self.partial = s.partial;
         self.ladd = s.ladd;
         self.set_exchange(s.exchange, s.exchange_sum);
         Ok(())
+    }
+
+    /// Continue the lattice from `s` (on a GPU: uploaded).
+    fn set_lbm_state(&mut self, s: LbmState) -> Result<()> {
+        match &mut self.fluid {
+            Lattices::Cpu(l) => l.set_state(s),
+            #[cfg(feature = "gpu")]
+            Lattices::Gpu(g) => crate::lbm::Fluid::set_state(g, s),
+        }
     }
 
     /// [`CoupledFluid::exchange`] and the exchange sum as the CPU keeps them (from the device's
@@ -407,11 +412,7 @@ impl<T: Real> Scale for CoupledFluid<T> {
         self.lbm().state()
     }
     fn restore(&mut self, s: LbmState) {
-        let restored = match &mut self.fluid {
-            Lattices::Cpu(l) => l.set_state(s),
-            #[cfg(feature = "gpu")]
-            Lattices::Gpu(g) => crate::lbm::Fluid::set_state(g, s),
-        };
-        restored.expect("a snapshot of this fluid restores into it");
+        self.set_lbm_state(s)
+            .expect("a snapshot of this fluid restores into it");
     }
 }

@@ -9,7 +9,7 @@
 //!
 //! Per cover ([`GpuLattice::set_cover`]): the previous cover's cells are cleared from the
 //! per-cell index and the new ones marked (`cover.wgsl`, one dispatch each), the entries'
-//! values uploaded and their momenta zeroed; the step kernel then sums each entry's momentum
+//! values uploaded and their momenta zeroed on the device; the step kernel then sums each entry's momentum
 //! over the steps until the next cover (one thread per cell writes its own entry: no races),
 //! and only those sums come back ([`GpuLattice::covered_exchange`]).
 
@@ -108,13 +108,17 @@ impl GpuLattice {
             .expect("the lattice was built with a covered term")
     }
 
-    /// One marking dispatch over the current cover's entries.
-    fn mark(&self, set: bool) {
+    /// One marking dispatch over the current cover's entries; when setting, their momentum
+    /// sums are zeroed on the device first (`bytes` of them).
+    fn mark(&self, set: bool, bytes: u64) {
         let cover = self.cover.as_ref().expect("built with a covered term");
         if cover.entries == 0 {
             return;
         }
         let mut encoder = self.device.create_command_encoder(&Default::default());
+        if set {
+            encoder.clear_buffer(&self.buffers[COVERED_EXCHANGE], 0, Some(bytes));
+        }
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             pass.set_pipeline(&cover.mark[usize::from(set)]);
@@ -133,7 +137,7 @@ impl GpuLattice {
         let per = self.cover_mut().values;
         assert_eq!(values.len(), per * n, "{per} values per covered cell");
         // Clear the previous cover's cells, from the buffer that still holds them.
-        self.mark(false);
+        self.mark(false, 0);
         if n > self.cover_mut().capacity {
             let capacity = n.max(2 * self.cover_mut().capacity);
             let usage = wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
@@ -170,15 +174,9 @@ impl GpuLattice {
                 0,
                 bytemuck::cast_slice(values),
             );
-            let zeros = vec![T::zero(); 2 * n];
-            self.queue.write_buffer(
-                &self.buffers[COVERED_EXCHANGE],
-                0,
-                bytemuck::cast_slice(&zeros),
-            );
         }
         self.cover_mut().entries = n;
-        self.mark(true);
+        self.mark(true, (2 * n * std::mem::size_of::<T>()) as u64);
     }
 
     /// The momentum each entry of the cover exchanged with the fluid, summed over the steps

@@ -10,6 +10,9 @@
 use super::d2q9::Q;
 use super::real::Real;
 
+/// The entry of a lane that no covered cell occupies ([`CoveredCells::apply`]).
+pub const UNCOVERED: usize = usize::MAX;
+
 /// The covered cells of one step and the collision term a coupling method applies to them.
 pub trait CoveredCells<T: Real>: Sync {
     /// Cell indices y·nx + x, ascending and unique.
@@ -19,11 +22,13 @@ pub trait CoveredCells<T: Real>: Sync {
     /// fully covered cell): a chunk of such cells skips the fluid collision.
     fn replaces_collision(&self, k: usize) -> bool;
 
-    /// Apply the term on `L` lanes: lane l is entry `entries[l]` of [`CoveredCells::cells`];
-    /// `g` holds the pre-collision populations, `post` the fluid collision C(g) on entry and
-    /// the post-collision populations on return; `force` is the body force the collision used
-    /// (lattice units). Returns the momentum the term gave the fluid in each lane. Lanes may
-    /// repeat an entry (padding); each lane must be computed from its own data only.
+    /// Apply the term on `L` lanes: lane l is entry `entries[l]` of [`CoveredCells::cells`],
+    /// or a fluid node when it is [`UNCOVERED`] (its `post` must come back unchanged, bit for
+    /// bit); `g` holds the pre-collision populations, `post` the fluid collision C(g) on entry
+    /// and the post-collision populations on return; `force` is the body force the collision
+    /// used (lattice units). Returns the momentum the term gave the fluid in each lane (any
+    /// value in an uncovered lane). Lanes may repeat an entry (padding); each lane must be
+    /// computed from its own data only.
     fn apply<const L: usize>(
         &self,
         entries: &[usize; L],

@@ -30,7 +30,7 @@ pub mod solver;
 pub use backend::Backend;
 pub use boundary::{Edge, Edges};
 pub use collision::{Collider, CollisionModel, MrtRates};
-pub use covered::CoveredCells;
+pub use covered::{CoveredCells, UNCOVERED};
 pub use lattice::Lattice;
 pub use observation::Observation;
 pub use obstacle::{Obstacle, Obstacles, Shape};

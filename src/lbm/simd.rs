@@ -65,7 +65,7 @@ pub(super) unsafe fn bulk_run<T: Real, const L: usize>(
         let len = x1 - x;
         for i in 0..Q {
             let dst = if even { i } else { OPP[i] };
-            std::ptr::copy_nonoverlapping(f.add(offs[i] + x), buf[dst].as_mut_ptr(), len);
+            copy_short(f.add(offs[i] + x), buf[dst].as_mut_ptr(), len);
             for l in len..L {
                 buf[dst][l] = buf[dst][0];
             }
@@ -73,9 +73,36 @@ pub(super) unsafe fn bulk_run<T: Real, const L: usize>(
         collider.collide(&mut buf);
         for i in 0..Q {
             let slot = if even { OPP[i] } else { i };
-            std::ptr::copy_nonoverlapping(buf[i].as_ptr(), f.add(offs[slot] + x), len);
+            copy_short(buf[i].as_ptr(), f.add(offs[slot] + x), len);
         }
     }
+}
+
+/// Copy `len < 64` values (a remainder of a chunk of up to 64 lanes) as at most six
+/// fixed-size moves: a copy by length is a library call, which cost the coupled step 10 % of
+/// its time in the short runs between covered cells (2026-12-07, perf).
+///
+/// # Safety
+/// As [`std::ptr::copy_nonoverlapping`] of `len` values.
+#[inline(always)]
+pub(super) unsafe fn copy_short<T: Copy>(src: *const T, dst: *mut T, len: usize) {
+    assert!(len < 64, "copy_short of {len} values");
+    let mut o = 0;
+    macro_rules! part {
+        ($size:literal) => {
+            if len & $size != 0 {
+                std::ptr::copy_nonoverlapping(src.add(o), dst.add(o), $size);
+                o += $size;
+            }
+        };
+    }
+    part!(32);
+    part!(16);
+    part!(8);
+    part!(4);
+    part!(2);
+    part!(1);
+    debug_assert_eq!(o, len);
 }
 
 /// Signature of the bulk loop: populations, stride, nx, ny, row, first and end node, even

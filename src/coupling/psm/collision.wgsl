@@ -7,7 +7,8 @@
 //
 // Written as Ω_i^s = (f_ī − f_i) + w_i ρ [3 e_i·(u_s + u) + 4.5 ((e_i·u_s)² − (e_i·u)²)
 // − 1.5 (|u_s|² − |u|²)]: the two equilibria's common w_i ρ cancels by hand, so in f32 the
-// term keeps the digits that the CPU keeps by blending in f64.
+// term loses no more than the populations' own rounding. The CPU blend
+// (`coupling::psm::collision::blend`) is the same arrangement.
 fn covered_term(e: u32, g: array<real, 9>, post: ptr<function, array<real, 9>>) -> vec2<real> {
     let b = covered_values[3u * e];
     let sx = covered_values[3u * e + 1u];

@@ -51,10 +51,10 @@ fn bulk_kernel_for<T: Real>() -> super::simd::BulkFn<T> {
     }
 }
 
-/// Covered cells per chunk of the partially saturated path, in either precision. Covered
-/// stretches are short (a disk's chord, ≈ 34 cells at the bench's 21-cell radius), and a
-/// chunk's unused lanes are collided all the same: 8 wastes ≈ 11 % of the lanes where 32
-/// wasted ≈ 47 % (the coupled step 4.8 → 3.7 s over 32 bench steps).
+/// Cells per chunk of the partially saturated path, in either precision. Chosen when each
+/// covered stretch (a disk's chord, ≈ 34 cells at the bench's 21-cell radius) was a pass of
+/// its own: 8 wasted ≈ 11 % of the lanes where 32 wasted ≈ 47 % (the coupled step 4.8 → 3.7 s
+/// over 32 bench steps). Not measured again since a pass spans a whole bulk run.
 const PSM_LANES: usize = 8;
 
 /// Direction-array stride: the cell count rounded up to a cache line of f64 and padded by
@@ -525,7 +525,7 @@ impl<T: Real> Lattice<T> {
                 let pass = |x0: u32, x1: u32, ks: usize, ke: usize| {
                     if ks == ke {
                         bulk(x0 as usize, x1 as usize);
-                    } else if x1 > x0 {
+                    } else {
                         // SAFETY: as in `step`; entries ks..ke of `exchange` belong to this
                         // row.
                         unsafe {

@@ -9,9 +9,9 @@
 //!
 //! Per cover ([`GpuLattice::set_cover`]): the previous cover's cells are cleared from the
 //! per-cell index and the new ones marked (`cover.wgsl`, one dispatch each), the entries'
-//! values uploaded and their momenta zeroed on the device; the step kernel then sums each entry's momentum
-//! over the steps until the next cover (one thread per cell writes its own entry: no races),
-//! and only those sums come back ([`GpuLattice::covered_exchange`]).
+//! values uploaded and their momenta zeroed on the device; the step kernel then sums each
+//! entry's momentum over the steps until the next cover (one thread per cell writes its own
+//! entry: no races), and only those sums come back ([`GpuLattice::covered_exchange`]).
 
 use wgpu::util::DeviceExt;
 

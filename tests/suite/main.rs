@@ -30,6 +30,8 @@ mod models;
 mod mpm;
 mod mpm_periodic;
 mod multiscale;
+// Xvfb and its sockets: Unix only.
+#[cfg(unix)]
 mod paraview;
 mod resume;
 mod schema;

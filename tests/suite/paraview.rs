@@ -9,9 +9,11 @@
 //!
 //! Set `GRANFLOW_KEEP_PARAVIEW=<dir>` to keep the rendered PNGs.
 
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Read, Write};
+use std::os::unix::net::UnixStream;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
+use std::sync::atomic::{AtomicU32, Ordering};
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -33,53 +35,103 @@ fn paraview_found() -> bool {
     found
 }
 
-/// A private X server for one ParaView call (Debian's ParaView renders through X):
-/// `Xvfb -displayfd 1` picks a free display itself and prints its number once it accepts
-/// connections, so calls never share or race for a display. Terminated on drop.
+/// A private X server for one ParaView call (Debian's ParaView renders through X), on a display
+/// number of its own: numbers are taken in turn from a block that depends on this process's id
+/// (`NEXT_DISPLAY`), and Xvfb is started on one explicitly — it exits if the display is in use
+/// (its lock file, or its socket in this network namespace), and the next number is tried.
+/// `-displayfd 1` prints the number once the server accepts connections, and
+/// [`Xvfb::answers`] then checks that it does, so a call never runs against a server it cannot
+/// reach. Terminated on drop; its messages are kept for the report of a lost connection.
 struct Xvfb {
     server: Child,
-    display: String,
+    display: u32,
+    log: tempfile::NamedTempFile,
 }
+
+/// The next display number to try; 0 until the first call picks the block.
+static NEXT_DISPLAY: AtomicU32 = AtomicU32::new(0);
 
 impl Xvfb {
     /// `None` where there is no `Xvfb` (a desktop with its own display).
     fn start() -> Option<Xvfb> {
-        let mut server = Command::new("Xvfb")
-            .args([
-                "-displayfd",
-                "1",
-                "-screen",
-                "0",
-                "1280x1024x24",
-                "-nolisten",
-                "tcp",
-            ])
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .ok()?;
-        let mut number = String::new();
-        BufReader::new(server.stdout.take().unwrap())
-            .read_line(&mut number)
-            .unwrap();
-        assert!(!number.trim().is_empty(), "Xvfb did not start");
-        Some(Xvfb {
-            server,
-            display: format!(":{}", number.trim()),
-        })
+        let _ = NEXT_DISPLAY.compare_exchange(
+            0,
+            100 + std::process::id() % 500 * 40,
+            Ordering::Relaxed,
+            Ordering::Relaxed,
+        );
+        let mut refused = String::new();
+        for _ in 0..20 {
+            let display = NEXT_DISPLAY.fetch_add(1, Ordering::Relaxed);
+            let log = tempfile::NamedTempFile::new().unwrap();
+            let mut server = Command::new("Xvfb")
+                .arg(format!(":{display}"))
+                .args(["-displayfd", "1", "-noreset", "-nolisten", "tcp"])
+                .args(["-screen", "0", "1280x1024x24"])
+                .stdout(Stdio::piped())
+                .stderr(log.reopen().unwrap())
+                .spawn()
+                .ok()?;
+            let mut number = String::new();
+            BufReader::new(server.stdout.take().unwrap())
+                .read_line(&mut number)
+                .unwrap();
+            let xvfb = Xvfb {
+                server,
+                display,
+                log,
+            };
+            if number.trim() == display.to_string() {
+                return Some(xvfb);
+            }
+            refused = xvfb.messages();
+        }
+        panic!("Xvfb found no free display in 20 tries; the last said:\n{refused}");
+    }
+
+    fn messages(&self) -> String {
+        std::fs::read_to_string(self.log.path()).unwrap_or_default()
+    }
+
+    /// Whether the server completes an X connection set-up (byte order, protocol 11.0, no
+    /// authorisation) on each socket a client may use: the abstract one, which libxcb tries
+    /// first on Linux, and the one in `/tmp/.X11-unix`.
+    fn answers(&self) -> Result<(), String> {
+        let path = format!("/tmp/.X11-unix/X{}", self.display);
+        let mut sockets = vec![("file", UnixStream::connect(&path))];
+        #[cfg(target_os = "linux")]
+        {
+            use std::os::linux::net::SocketAddrExt;
+            let address = std::os::unix::net::SocketAddr::from_abstract_name(path.as_bytes());
+            sockets.insert(0, ("abstract", UnixStream::connect_addr(&address.unwrap())));
+        }
+        for (kind, socket) in sockets {
+            let setup = socket.and_then(|mut s| {
+                s.write_all(&[b'l', 0, 11, 0, 0, 0, 0, 0, 0, 0, 0, 0])?;
+                let mut status = [0u8; 1];
+                s.read_exact(&mut status)?;
+                Ok(status[0])
+            });
+            match setup {
+                Ok(1) => {}
+                Ok(s) => return Err(format!("{kind} socket {path}: set-up refused ({s})")),
+                Err(e) => return Err(format!("{kind} socket {path}: {e}")),
+            }
+        }
+        Ok(())
     }
 }
 
 /// SIGTERM, so the server removes its lock file and socket: after a SIGKILL the next server
 /// takes the same display over the stale socket, and 2 of 10 ParaView calls measured in a row
-/// lost their connection ("bad X server connection"; 0 of 10 with SIGTERM).
+/// lost their connection ("bad X server connection"; 0 of 10 with SIGTERM). Sent with
+/// `libc::kill`, not a `kill` program a machine may lack.
 impl Drop for Xvfb {
     fn drop(&mut self) {
-        let terminated = Command::new("kill")
-            .args(["-TERM", &self.server.id().to_string()])
-            .status()
-            .is_ok_and(|s| s.success());
-        if !terminated {
+        let pid = self.server.id() as libc::pid_t;
+        // SAFETY: `kill` only sends a signal; the child is not yet waited for, so `pid` is
+        // still the server's.
+        if unsafe { libc::kill(pid, libc::SIGTERM) } != 0 {
             let _ = self.server.kill();
         }
         let _ = self.server.wait();
@@ -87,15 +139,27 @@ impl Drop for Xvfb {
 }
 
 /// `pvpython scripts/paraview/SCRIPT ARGS…`, on its own [`Xvfb`] where there is one. A call
-/// whose X connection still fails ("bad X server connection") is retried on a new server, up
-/// to three times: the check is of the files and the scripts, not of the X server.
+/// whose server does not answer, or whose X connection still fails ("bad X server
+/// connection"), is retried on a new server, up to three times, each loss reported with the
+/// server's messages: the check is of the files and the scripts, not of the X server.
 fn pvpython(script: &str, args: &[&Path], extra: &[&str]) -> Output {
     let mut tries = 0;
     loop {
+        tries += 1;
         let xvfb = Xvfb::start();
+        if let Some(Err(why)) = xvfb.as_ref().map(Xvfb::answers) {
+            let x = xvfb.as_ref().unwrap();
+            eprintln!(
+                "{script}: Xvfb :{} does not answer ({why}); it said:\n{}",
+                x.display,
+                x.messages()
+            );
+            assert!(tries < 3, "Xvfb did not answer in 3 tries");
+            continue;
+        }
         let mut cmd = Command::new("pvpython");
         if let Some(x) = &xvfb {
-            cmd.env("DISPLAY", &x.display);
+            cmd.env("DISPLAY", format!(":{}", x.display));
         }
         let out = cmd
             .arg(root().join("scripts/paraview").join(script))
@@ -103,12 +167,17 @@ fn pvpython(script: &str, args: &[&Path], extra: &[&str]) -> Output {
             .args(extra)
             .output()
             .unwrap();
-        tries += 1;
         let lost = String::from_utf8_lossy(&out.stderr).contains("bad X server connection");
         if !lost || tries == 3 {
             return out;
         }
-        eprintln!("{script}: X connection failed, retrying on a new server");
+        let x = xvfb.as_ref().unwrap();
+        let now = x.answers().err().unwrap_or_else(|| "it answers now".into());
+        eprintln!(
+            "{script}: X connection to :{} lost ({now}), retrying on a new server; Xvfb said:\n{}",
+            x.display,
+            x.messages()
+        );
     }
 }
 

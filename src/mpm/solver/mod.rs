@@ -65,7 +65,7 @@ use rayon::prelude::*;
 use super::grid::{Grid, NodeSums};
 use super::material::{Material, MaterialModel, Stress};
 use super::points::{PermuteScratch, Points};
-use super::shape::{weights_1d, ShapeKind};
+use super::shape::{weights_1d, Shape1d, ShapeKind};
 use crate::{Error, Result};
 
 mod transfer;
@@ -258,10 +258,11 @@ struct Stencil {
     gy: [f64; 3],
 }
 
+/// The stencil of the point at `p` whose shape along both directions is `s`.
 #[inline(always)]
-fn stencil(shape: ShapeKind, origin: [f64; 2], h: f64, p: [f64; 2], lp: f64) -> Stencil {
-    let (i0, wx, gx) = weights_1d(shape, p[0] - origin[0], h, lp);
-    let (j0, wy, gy) = weights_1d(shape, p[1] - origin[1], h, lp);
+fn stencil(s: Shape1d, origin: [f64; 2], p: [f64; 2]) -> Stencil {
+    let (i0, wx, gx) = s.weights(p[0] - origin[0]);
+    let (j0, wy, gy) = s.weights(p[1] - origin[1]);
     Stencil {
         i0,
         j0,
@@ -282,8 +283,9 @@ fn stencils(
     lp: &[f64],
     out: &mut [Stencil],
 ) {
+    let inv_h = 1.0 / h;
     for ((st, &x), &lp) in out.iter_mut().zip(x).zip(lp) {
-        *st = stencil(shape, origin, h, x, lp);
+        *st = stencil(Shape1d::with_inverse(shape, h, inv_h, lp), origin, x);
     }
 }
 

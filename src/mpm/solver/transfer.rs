@@ -81,39 +81,46 @@ impl<M: Material> Mpm<M> {
         let ns = self.stripe_start.len() - 1;
         self.stripe_start.iter_mut().for_each(|c| *c = 0);
         let (origin, h) = (g.origin, g.h);
+        let (nx, ny) = (g.nx as i64, g.ny as i64);
+        // Each point's stencil and stripe, in parallel; `OUTSIDE` marks a point that is not
+        // finite or whose stencil leaves the grid.
+        const OUTSIDE: u32 = u32::MAX;
         self.stencils
             .par_chunks_mut(CHUNK)
             .zip(self.points.pos.par_chunks(CHUNK))
             .zip(self.points.half_size.par_chunks(CHUNK))
-            .for_each(|((sts, xs), lps)| {
+            .zip(self.stripe_of.par_chunks_mut(CHUNK))
+            .for_each(|(((sts, xs), lps), stripes)| {
                 simd::dispatch!(stencils(shape, origin, h, xs, lps, sts));
+                for ((stripe, st), x) in stripes.iter_mut().zip(sts.iter()).zip(xs) {
+                    let inside = x[0].is_finite()
+                        && x[1].is_finite()
+                        && st.i0 >= 0
+                        && st.j0 >= 0
+                        && st.i0 + 2 <= nx
+                        && st.j0 + 2 <= ny;
+                    *stripe = if inside {
+                        (st.i0 as usize / STRIPE) as u32
+                    } else {
+                        OUTSIDE
+                    };
+                }
             });
-        for (p, (&x, st)) in self.points.pos.iter().zip(&self.stencils).enumerate() {
-            let ok = x[0].is_finite()
-                && x[1].is_finite()
-                && st.i0 >= 0
-                && st.j0 >= 0
-                && st.i0 + 2 <= g.nx as i64
-                && st.j0 + 2 <= g.ny as i64;
-            if !ok {
-                let c = [
-                    ((x[0] - g.origin[0]) / g.h).max(0.0) as usize,
-                    ((x[1] - g.origin[1]) / g.h).max(0.0) as usize,
-                ];
+        for (p, &s) in self.stripe_of.iter().enumerate() {
+            if s == OUTSIDE {
+                let x = self.points.pos[p];
                 return Err(Error::Unstable {
                     step: self.steps,
                     time: self.time,
-                    x: c[0],
-                    y: c[1],
+                    x: ((x[0] - origin[0]) / h).max(0.0) as usize,
+                    y: ((x[1] - origin[1]) / h).max(0.0) as usize,
                     reason: format!(
                         "material point {p} at ({:e}, {:e}) m is not finite or left the grid",
                         x[0], x[1]
                     ),
                 });
             }
-            let s = st.i0 as usize / STRIPE;
-            self.stripe_of[p] = s as u32;
-            self.stripe_start[s + 1] += 1;
+            self.stripe_start[s as usize + 1] += 1;
         }
         for s in 0..ns {
             self.stripe_start[s + 1] += self.stripe_start[s];
@@ -192,6 +199,9 @@ impl<M: Material> Mpm<M> {
             g.sums[head..]
                 .par_chunks_mut(chunk_len)
                 .enumerate()
+                // One task per stripe: a column at one end of the grid has all its stripes
+                // in the first chunks, which rayon's first splits would give to one thread.
+                .with_max_len(1)
                 .for_each(|(k, chunk): (usize, &mut [NodeSums])| {
                     let s = 2 * k + phase;
                     if s < ns {

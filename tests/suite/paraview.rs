@@ -89,6 +89,7 @@ impl Xvfb {
         panic!("Xvfb found no free display in 20 tries; the last said:\n{refused}");
     }
 
+    /// What the server wrote to its stderr so far.
     fn messages(&self) -> String {
         std::fs::read_to_string(self.log.path()).unwrap_or_default()
     }
@@ -147,15 +148,16 @@ fn pvpython(script: &str, args: &[&Path], extra: &[&str]) -> Output {
     loop {
         tries += 1;
         let xvfb = Xvfb::start();
-        if let Some(Err(why)) = xvfb.as_ref().map(Xvfb::answers) {
-            let x = xvfb.as_ref().unwrap();
-            eprintln!(
-                "{script}: Xvfb :{} does not answer ({why}); it said:\n{}",
-                x.display,
-                x.messages()
-            );
-            assert!(tries < 3, "Xvfb did not answer in 3 tries");
-            continue;
+        if let Some(x) = &xvfb {
+            if let Err(why) = x.answers() {
+                eprintln!(
+                    "{script}: Xvfb :{} does not answer ({why}); it said:\n{}",
+                    x.display,
+                    x.messages()
+                );
+                assert!(tries < 3, "Xvfb did not answer in 3 tries");
+                continue;
+            }
         }
         let mut cmd = Command::new("pvpython");
         if let Some(x) = &xvfb {
@@ -171,13 +173,15 @@ fn pvpython(script: &str, args: &[&Path], extra: &[&str]) -> Output {
         if !lost || tries == 3 {
             return out;
         }
-        let x = xvfb.as_ref().unwrap();
-        let now = x.answers().err().unwrap_or_else(|| "it answers now".into());
-        eprintln!(
-            "{script}: X connection to :{} lost ({now}), retrying on a new server; Xvfb said:\n{}",
-            x.display,
-            x.messages()
-        );
+        match &xvfb {
+            Some(x) => eprintln!(
+                "{script}: X connection to :{} lost ({}), retrying on a new server; it said:\n{}",
+                x.display,
+                x.answers().err().unwrap_or_else(|| "it answers now".into()),
+                x.messages()
+            ),
+            None => eprintln!("{script}: X connection lost, retrying"),
+        }
     }
 }
 

@@ -90,14 +90,23 @@ enum Command {
         backend: Backend,
     },
     /// Run a column-collapse sweep (cases in parallel, resumable) and write sweep.csv,
-    /// fits.json and the figures.
+    /// fits.json and the figures. Under `mpirun` (a build with the feature `mpi`) the cases
+    /// are spread over the ranks.
     Sweep {
         /// Sweep file (TOML): base scenario per solver and the values to vary.
         sweep: PathBuf,
         /// Output folder: one sub-folder per case, plus the tables and figures.
-        #[arg(long)]
-        out: PathBuf,
-        /// Cases run at the same time (0: one per core).
+        #[arg(long, required_unless_present = "list")]
+        out: Option<PathBuf>,
+        /// List the cases (number, name, solver, varied values; with --out, whether each is
+        /// done) and run nothing.
+        #[arg(long, conflicts_with_all = ["case", "jobs", "checkpoint_every"])]
+        list: bool,
+        /// Run only this case, by number (from 0, as --list prints) or name, e.g. a job
+        /// array's task id; a later plain `granflow sweep` reuses it and writes the tables.
+        #[arg(long, value_name = "K", conflicts_with = "jobs")]
+        case: Option<String>,
+        /// Cases run at the same time (0: one per core), on each MPI rank under mpirun.
         #[arg(long, default_value_t = 0)]
         jobs: usize,
         /// Save each case's state every SECONDS of simulated time, so that a sweep run again
@@ -462,9 +471,18 @@ fn real_main() -> Result<ExitCode> {
         Command::Sweep {
             sweep,
             out,
+            list,
+            case,
             jobs,
             checkpoint_every,
-        } => cli::study::sweep(&sweep, &out, jobs, checkpoint_every),
+        } => match (out, list) {
+            (out, true) => cli::study::sweep_list(&sweep, out.as_deref()),
+            (Some(out), false) => match case {
+                Some(k) => cli::study::sweep_case(&sweep, &out, &k, checkpoint_every),
+                None => cli::study::sweep(&sweep, &out, jobs, checkpoint_every),
+            },
+            (None, false) => unreachable!("clap requires --out unless --list"),
+        },
         Command::Biaxial {
             scenario,
             out,

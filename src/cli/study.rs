@@ -20,6 +20,24 @@ pub fn sweep(
     checkpoint_every: Option<f64>,
 ) -> Result<ExitCode> {
     let stop = super::stop_on_signals()?;
+    #[cfg(feature = "mpi")]
+    let r = {
+        use mpi::topology::Communicator;
+        let (universe, _) = mpi::initialize_with_threading(mpi::Threading::Funneled)
+            .context("MPI could not be initialised")?;
+        let world = universe.world();
+        if world.size() == 1 {
+            granflow::sweep::run_sweep(path, out, jobs, checkpoint_every, stop)?
+        } else {
+            use granflow::sweep::ranks::run_sweep_on_ranks;
+            match run_sweep_on_ranks(&world, path, out, jobs, checkpoint_every, stop)? {
+                Some(r) => r,
+                // The other ranks leave the report to rank 0.
+                None => return Ok(ExitCode::SUCCESS),
+            }
+        }
+    };
+    #[cfg(not(feature = "mpi"))]
     let r = granflow::sweep::run_sweep(path, out, jobs, checkpoint_every, stop)?;
     for g in &r.fits.groups {
         let with: String = g.with.iter().map(|(p, v)| format!(" {p}={v}")).collect();
@@ -71,6 +89,44 @@ pub fn sweep(
             );
         }
         Ok(ExitCode::FAILURE)
+    }
+}
+
+/// `granflow sweep FILE --list [--out DIR]`: the cases, numbered as `--case` takes them, and
+/// with `DIR` where each stands.
+pub fn sweep_list(path: &Path, out: Option<&Path>) -> Result<ExitCode> {
+    let (_, cases) = granflow::sweep::read_sweep(path)?;
+    let states = out.map(|o| granflow::sweep::case_states(&cases, o));
+    for (k, c) in cases.iter().enumerate() {
+        let labels: Vec<String> = c.labels.iter().map(|(p, v)| format!("{p}={v}")).collect();
+        let state = states
+            .as_ref()
+            .map_or(String::new(), |s| format!("\t{}", s[k]));
+        println!(
+            "{k}\t{}\t{}\t{}{state}",
+            c.name,
+            c.solver.name(),
+            labels.join(" ")
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `granflow sweep FILE --out DIR --case K`: one case, as a job of an array runs it.
+pub fn sweep_case(
+    path: &Path,
+    out: &Path,
+    which: &str,
+    checkpoint_every: Option<f64>,
+) -> Result<ExitCode> {
+    let stop = super::stop_on_signals()?;
+    let r = granflow::sweep::run_one_case(path, out, which, checkpoint_every, stop)?;
+    match &r.outcome {
+        Ok(_) => Ok(ExitCode::SUCCESS),
+        Err(e) => {
+            eprintln!("failed: {}: {e}", r.case.name);
+            Ok(ExitCode::FAILURE)
+        }
     }
 }
 

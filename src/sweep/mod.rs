@@ -12,9 +12,16 @@
 //! (`--checkpoint-every`, or a stop by SIGINT/SIGTERM) continues from the newest. A failed
 //! case is reported with its error and the others go on. Asked to stop, the running cases stop
 //! with a checkpoint, no new case starts, and the sweep ends with [`Error::Interrupted`].
+//!
+//! Beyond one machine: [`run_one_case`] runs a single case (`granflow sweep FILE --out DIR
+//! --case K`, a scheduler's job array, one task per case), after which a plain sweep of the
+//! same file and folder reuses every finished case and writes the tables; with the feature
+//! `mpi`, `ranks` spreads the cases over MPI ranks.
 
 pub mod figures;
 pub mod progress;
+#[cfg(feature = "mpi")]
+pub mod ranks;
 pub mod spec;
 pub mod table;
 
@@ -135,6 +142,53 @@ fn end_milli_tc(case: &Case) -> u64 {
         .map_or(0, |e| (1e3 * e) as u64)
 }
 
+/// One case of a sweep run in `out` (or reused from an earlier run there): what becomes of
+/// case `k` of `cases` (see the module doc).
+fn run_case_in(
+    cases: &[Case],
+    k: usize,
+    out: &Path,
+    every: Option<f64>,
+    stop: &Arc<AtomicUsize>,
+    display: &progress::Display,
+) -> CaseResult {
+    let case = &cases[k];
+    let dir = out.join(&case.name);
+    let (outcome, reused, resumed) = match reusable(case, &dir) {
+        Some(o) => (Ok(o), true, false),
+        None if stop.load(Ordering::Relaxed) != 0 => (Err(NOT_STARTED.into()), false, false),
+        None => {
+            let mut bar = display.start(k, end_milli_tc(case));
+            match run_case(case, &dir, every, stop, &mut bar) {
+                Ok((o, resumed)) => (Ok(o), false, resumed),
+                Err(e) => (Err(format!("{e:#}")), false, false),
+            }
+        }
+    };
+    display.finish(k, &outcome, reused);
+    CaseResult {
+        case: case.clone(),
+        dir,
+        outcome,
+        reused,
+        resumed,
+    }
+}
+
+/// The outcome of a case that a stopped sweep never started.
+const NOT_STARTED: &str = "not started: the sweep was stopped";
+
+/// The sweep of `path`, every case checked (a bad value fails the sweep before anything
+/// runs), and its output folder `out` created.
+fn prepare(path: &Path, out: &Path) -> Result<(SweepSpec, Vec<Case>)> {
+    let (spec, cases) = read_sweep(path)?;
+    for case in &cases {
+        case.check()?;
+    }
+    crate::io::run_dir::create(out)?;
+    Ok((spec, cases))
+}
+
 /// Runs the sweep of `path` into `out`: `jobs` cases at a time (0: as many as the rayon pool
 /// has threads), each checkpointing every `every` simulated seconds (if given) and stopping
 /// when `stop` is set; then writes `sweep.csv`, `fits.json` and the figures.
@@ -145,44 +199,16 @@ pub fn run_sweep(
     every: Option<f64>,
     stop: Arc<AtomicUsize>,
 ) -> Result<SweepReport> {
-    let (spec, cases) = read_sweep(path)?;
-    // Every case must parse before anything runs: a bad value fails the sweep up front.
-    for case in &cases {
-        case.check()?;
-    }
-    crate::io::run_dir::create(out)?;
+    let (spec, cases) = prepare(path, out)?;
     let display = progress::Display::new(&cases);
     let results: Mutex<Vec<Option<CaseResult>>> = Mutex::new(vec![None; cases.len()]);
     let work = || {
-        cases
-            .par_iter()
-            .enumerate()
+        (0..cases.len())
+            .into_par_iter()
             .with_max_len(1)
-            .for_each(|(k, case)| {
-                let dir = out.join(&case.name);
-                let (outcome, reused, resumed) = match reusable(case, &dir) {
-                    Some(o) => (Ok(o), true, false),
-                    None if stop.load(Ordering::Relaxed) != 0 => (
-                        Err("not started: the sweep was stopped".into()),
-                        false,
-                        false,
-                    ),
-                    None => {
-                        let mut bar = display.start(k, end_milli_tc(case));
-                        match run_case(case, &dir, every, &stop, &mut bar) {
-                            Ok((o, resumed)) => (Ok(o), false, resumed),
-                            Err(e) => (Err(format!("{e:#}")), false, false),
-                        }
-                    }
-                };
-                display.finish(k, &outcome, reused);
-                results.lock().expect("no panic while holding the lock")[k] = Some(CaseResult {
-                    case: case.clone(),
-                    dir,
-                    outcome,
-                    reused,
-                    resumed,
-                });
+            .for_each(|k| {
+                let r = run_case_in(&cases, k, out, every, &stop, &display);
+                results.lock().expect("no panic while holding the lock")[k] = Some(r);
             })
     };
     if jobs == 0 {
@@ -194,11 +220,34 @@ pub fn run_sweep(
             .map_err(|e| Error::Other(e.to_string()))?
             .install(work);
     }
-    let cases: Vec<CaseResult> = results
+    let results = results
         .into_inner()
-        .expect("no panic while holding the lock")
+        .expect("no panic while holding the lock");
+    gather(path, out, (spec, cases), results, &stop)
+}
+
+/// The results of the sweep `path` (its spec and cases as read) written out: `sweep.csv`,
+/// `fits.json` and the figures, or, when `stop` was set, the interruption with the command
+/// that continues it. A case without a result never started.
+fn gather(
+    path: &Path,
+    out: &Path,
+    (spec, cases): (SweepSpec, Vec<Case>),
+    results: Vec<Option<CaseResult>>,
+    stop: &AtomicUsize,
+) -> Result<SweepReport> {
+    let cases: Vec<CaseResult> = results
         .into_iter()
-        .map(|r| r.expect("every case ran"))
+        .zip(cases)
+        .map(|(r, case)| {
+            r.unwrap_or_else(|| CaseResult {
+                dir: out.join(&case.name),
+                case,
+                outcome: Err(NOT_STARTED.into()),
+                reused: false,
+                resumed: false,
+            })
+        })
         .collect();
     let signal = stop.load(Ordering::Relaxed);
     if signal != 0 {
@@ -215,4 +264,84 @@ pub fn run_sweep(
     crate::io::write_json(&out.join("fits.json"), &fits)?;
     figures::write_all(out, &cases, &fits)?;
     Ok(SweepReport { spec, cases, fits })
+}
+
+/// The case of `cases` that `which` names: its index in [`spec::expand`]'s order (from 0, as
+/// `granflow sweep --list` numbers them and a job array's task id counts) or its name.
+pub fn find_case(cases: &[Case], which: &str) -> Result<usize> {
+    if let Ok(k) = which.parse::<usize>() {
+        return if k < cases.len() {
+            Ok(k)
+        } else {
+            Err(Error::config(
+                "--case",
+                format!(
+                    "the sweep has {} cases, numbered 0 to {}; {k} is not one",
+                    cases.len(),
+                    cases.len().saturating_sub(1)
+                ),
+            ))
+        };
+    }
+    cases.iter().position(|c| c.name == which).ok_or_else(|| {
+        Error::config(
+            "--case",
+            format!("no case is named `{which}` (`granflow sweep FILE --list` lists them)"),
+        )
+    })
+}
+
+/// Runs one case of the sweep of `path` (see [`find_case`]) into its folder under `out`, as
+/// a job of a scheduler's array does: the same folder, reuse and checkpoints as a whole
+/// sweep, and nothing written outside the case's folder. A later `granflow sweep` of the same
+/// file and `out` reuses the case and, once every case is done, writes the tables.
+pub fn run_one_case(
+    path: &Path,
+    out: &Path,
+    which: &str,
+    every: Option<f64>,
+    stop: Arc<AtomicUsize>,
+) -> Result<CaseResult> {
+    let (_, cases) = read_sweep(path)?;
+    let k = find_case(&cases, which)?;
+    cases[k].check()?;
+    crate::io::run_dir::create(out)?;
+    let display = progress::Display::new(&cases);
+    let r = run_case_in(&cases, k, out, every, &stop, &display);
+    let signal = stop.load(Ordering::Relaxed);
+    if signal != 0 {
+        return Err(Error::Interrupted {
+            signal: signal as i32,
+            at: format!("in case {}", r.case.name),
+            saved: r.dir,
+            resume: format!(
+                "granflow sweep {} --out {} --case {which}",
+                path.display(),
+                out.display()
+            ),
+        });
+    }
+    Ok(r)
+}
+
+/// Where each case of a sweep stands in `out`: done (a complete summary of the same resolved
+/// scenario), stopped part-way (checkpoints of it) or not run.
+pub fn case_states(cases: &[Case], out: &Path) -> Vec<&'static str> {
+    cases
+        .iter()
+        .map(|case| {
+            let dir = out.join(&case.name);
+            let same = std::fs::read_to_string(dir.join(SCENARIO_FILE))
+                .ok()
+                .as_ref()
+                == Some(&case.scenario);
+            if reusable(case, &dir).is_some() {
+                "done"
+            } else if same && checkpoint::list(&dir).is_ok_and(|l| !l.is_empty()) {
+                "stopped"
+            } else {
+                "not run"
+            }
+        })
+        .collect()
 }

@@ -626,3 +626,68 @@ fn a_closed_output_pipe_ends_quietly() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
+
+/// A sweep run case by case, as a scheduler's job array runs it: `--list` numbers the cases
+/// (and, given the output folder, says which are done), `--case` runs one case and writes
+/// nothing outside its folder, a case that does not exist is refused naming `--case`, and a
+/// plain sweep afterwards reuses the finished case and writes the table of all four.
+#[test]
+fn a_sweep_runs_case_by_case() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = data("small_sweep.toml");
+    let out = dir.path().join("out");
+    let sweep_with = |extra: &[&str]| {
+        let o = granflow()
+            .arg("sweep")
+            .arg(&sweep)
+            .args(extra)
+            .output()
+            .unwrap();
+        let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+        (o.status.success(), text(&o.stdout), text(&o.stderr))
+    };
+    let out_arg = out.to_str().unwrap();
+
+    let (ok, listed, err) = sweep_with(&["--list"]);
+    assert!(ok, "{err}");
+    let names: Vec<&str> = listed
+        .lines()
+        .map(|l| l.split('\t').nth(1).unwrap())
+        .collect();
+    assert_eq!(names.len(), 4, "{listed}");
+    assert!(
+        listed
+            .lines()
+            .nth(1)
+            .unwrap()
+            .starts_with(&format!("1\t{}\tdem\tcolumn.aspect_ratio=1.25", names[1])),
+        "{listed}"
+    );
+
+    let (ok, _, err) = sweep_with(&["--out", out_arg, "--case", "1"]);
+    assert!(ok, "{err}");
+    assert!(out.join(names[1]).join("summary.json").exists());
+    assert!(!out.join(names[0]).exists() && !out.join("sweep.csv").exists());
+    let (ok, listed, err) = sweep_with(&["--list", "--out", out_arg]);
+    assert!(ok, "{err}");
+    let states: Vec<&str> = listed
+        .lines()
+        .map(|l| l.rsplit('\t').next().unwrap())
+        .collect();
+    assert_eq!(
+        states,
+        ["not run", "done", "not run", "not run"],
+        "{listed}"
+    );
+
+    for (which, said) in [("4", "numbered 0 to 3"), ("dem_a9", "no case is named")] {
+        let (ok, _, err) = sweep_with(&["--out", out_arg, "--case", which]);
+        assert!(!ok && err.contains("--case") && err.contains(said), "{err}");
+    }
+
+    let (ok, _, err) = sweep_with(&["--out", out_arg, "--jobs", "2"]);
+    assert!(ok, "{err}");
+    assert!(err.contains(&format!("{}: reused", names[1])), "{err}");
+    let table = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    assert_eq!(table.lines().count(), 5, "{table}");
+}

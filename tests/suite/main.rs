@@ -27,6 +27,8 @@ mod gpu;
 mod granular;
 mod io_vtk;
 mod models;
+#[cfg(feature = "mpi")]
+mod mpi;
 mod mpm;
 mod mpm_periodic;
 mod multiscale;

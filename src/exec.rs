@@ -1,6 +1,7 @@
 //! Execution helpers shared by the solvers and the runners: progress callbacks, thread pools,
 //! the median of timed repeats and the memory a run may take.
 
+pub mod machine;
 pub mod simd;
 
 use crate::{Error, Result};

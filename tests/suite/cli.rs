@@ -691,3 +691,22 @@ fn a_sweep_runs_case_by_case() {
     let table = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
     assert_eq!(table.lines().count(), 5, "{table}");
 }
+
+/// `granflow bench … --json` names the machine it ran on: the CPU's model, its logical CPUs,
+/// the threads used and a measured copy bandwidth.
+#[test]
+fn bench_names_its_machine() {
+    let o = granflow()
+        .args(["bench", "dem", "--grains", "200", "--steps", "20"])
+        .args(["--repeats", "1", "--threads", "1", "--json"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let m = &v["machine"];
+    assert!(!m["cpu_model"].as_str().unwrap().is_empty(), "{v}");
+    assert!(m["logical_cpus"].as_u64().unwrap() >= 1, "{v}");
+    assert_eq!(m["threads"].as_u64(), Some(1), "{v}");
+    assert!(m["copy_gb_s"].as_f64().unwrap() > 0.0, "{v}");
+    assert!(v["particle_steps_per_s"].as_f64().unwrap() > 0.0, "{v}");
+}

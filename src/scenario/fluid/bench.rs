@@ -11,9 +11,9 @@
 
 use std::time::Instant;
 
-use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::exec::machine::copy_bandwidth;
 use crate::exec::{median, on_threads};
 use crate::lbm::{
     Backend, CollisionModel, Edges, Fluid, FluidModel, Lattice, Lbm, MrtRates, Obstacles, Real,
@@ -146,25 +146,6 @@ fn time_gpu(case: &LbmCase, repeats: usize) -> Result<(Vec<f64>, f64, Option<Str
 #[cfg(not(feature = "gpu"))]
 fn time_gpu(_: &LbmCase, _: usize) -> Result<(Vec<f64>, f64, Option<String>)> {
     Err(Error::Other(crate::lbm::backend::NOT_BUILT.into()))
-}
-
-/// Parallel copy bandwidth (GB/s, read + write) of two arrays of `bytes` each; best of 5.
-pub fn copy_bandwidth(bytes: usize) -> f64 {
-    let n = (bytes / 8).max(1 << 20);
-    let src = vec![1.0f64; n];
-    let mut dst = vec![0.0f64; n];
-    let chunk = n.div_ceil(rayon::current_num_threads() * 4);
-    let mut best: f64 = 0.0;
-    for _ in 0..5 {
-        let t0 = Instant::now();
-        dst.par_chunks_mut(chunk)
-            .zip(src.par_chunks(chunk))
-            .for_each(|(d, s)| d.copy_from_slice(s));
-        let dt = t0.elapsed().as_secs_f64();
-        best = best.max(2.0 * (n * 8) as f64 / dt / 1e9);
-    }
-    std::hint::black_box(&dst);
-    best
 }
 
 /// Run the LBM benchmark of `case` on `threads` threads (0: rayon's default).

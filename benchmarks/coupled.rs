@@ -3,12 +3,9 @@
 //! The default is a quarter of the seed's Table 5.3 case (1200 × 1500 nodes, 625 grains of
 //! the same size); `GRANFLOW_BENCH_NX`, `_NY`, `_GRAINS` and `_STEPS` (default 20) change it.
 
-fn env(name: &str, default: usize) -> usize {
-    std::env::var(name)
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+#[path = "common.rs"]
+mod common;
+use common::env;
 
 fn main() {
     use granflow::scenario::submerged::bench::{coupled, CoupledCase};

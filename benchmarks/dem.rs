@@ -2,12 +2,9 @@
 //! measurement as `granflow bench dem`), with the machine it ran on. Size and steps:
 //! `GRANFLOW_BENCH_GRAINS` (default 10 000), `GRANFLOW_BENCH_STEPS` (default 1000).
 
-fn env(name: &str, default: usize) -> usize {
-    std::env::var(name)
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+#[path = "common.rs"]
+mod common;
+use common::env;
 
 fn main() {
     let grains = env("GRANFLOW_BENCH_GRAINS", 10_000);

@@ -2,12 +2,9 @@
 //! each beside the measured copy bandwidth (the same measurement as `granflow bench lbm`).
 //! Size and steps: `GRANFLOW_BENCH_N` (default 1024), `GRANFLOW_BENCH_STEPS` (default 50).
 
-fn env(name: &str, default: usize) -> usize {
-    std::env::var(name)
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+#[path = "common.rs"]
+mod common;
+use common::env;
 
 fn main() {
     let n = env("GRANFLOW_BENCH_N", 1024);
@@ -35,4 +32,5 @@ fn main() {
             }
         }
     }
+    println!("machine: {}", granflow::exec::machine::Machine::measure());
 }

@@ -2,12 +2,9 @@
 //! measurement), uGIMP and standard shape functions, with the machine it ran on. Points and
 //! steps: `GRANFLOW_BENCH_POINTS` (default 32 768), `GRANFLOW_BENCH_STEPS` (default 200).
 
-fn env(name: &str, default: usize) -> usize {
-    std::env::var(name)
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+#[path = "common.rs"]
+mod common;
+use common::env;
 
 fn main() {
     use granflow::mpm::ShapeKind;

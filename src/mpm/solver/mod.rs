@@ -258,6 +258,28 @@ struct Stencil {
     gy: [f64; 3],
 }
 
+impl Stencil {
+    /// APIC's node offsets x_i − x_p of the point at `x` (per direction, the stencil's three
+    /// node columns and rows) and its inertia D_p = diag(Σ_i N_ip (x_i − x_p)²), which is
+    /// diagonal for a tensor-product shape: C_p = B_p D_p⁻¹ (Jiang et al. 2015).
+    #[inline(always)]
+    fn apic_offsets(
+        &self,
+        x: [f64; 2],
+        origin: [f64; 2],
+        h: f64,
+    ) -> ([f64; 3], [f64; 3], [f64; 2]) {
+        let (mut dx, mut dy, mut d) = ([0.0; 3], [0.0; 3], [0.0; 2]);
+        for k in 0..3 {
+            dx[k] = origin[0] + (self.i0 + k as i64) as f64 * h - x[0];
+            dy[k] = origin[1] + (self.j0 + k as i64) as f64 * h - x[1];
+            d[0] += self.wx[k] * dx[k] * dx[k];
+            d[1] += self.wy[k] * dy[k] * dy[k];
+        }
+        (dx, dy, d)
+    }
+}
+
 /// The stencil of the point at `p` whose shape along both directions is `s`.
 #[inline(always)]
 fn stencil(s: Shape1d, origin: [f64; 2], p: [f64; 2]) -> Stencil {
@@ -407,6 +429,24 @@ impl<M: Material> Mpm<M> {
             *b = [0.0; 4];
         }
         Ok(())
+    }
+
+    /// Start the APIC affine matrices from the velocity gradient `grad(x)` = (∂u/∂x, ∂u/∂y,
+    /// ∂v/∂x, ∂v/∂y) at each point: B_p = C_p D_p with C_p = ∇v(x_p) and D_p the point's
+    /// inertia ([`Stencil::apic_offsets`]), the inverse of the point-to-grid transfer's C_p =
+    /// B_p D_p⁻¹, so that the first transfer carries the field's affine part (an affine field
+    /// reaches the grid exactly). Nothing to set with FLIP/PIC, which have no affine term.
+    pub fn set_velocity_gradient(&mut self, grad: impl Fn([f64; 2]) -> [f64; 4]) {
+        if self.transfer != Transfer::Apic {
+            return;
+        }
+        let (origin, h) = (self.grid.origin, self.grid.h);
+        let p = &mut self.points;
+        for ((b, &x), st) in p.affine.iter_mut().zip(&p.pos).zip(&self.stencils) {
+            let (_, _, d) = st.apic_offsets(x, origin, h);
+            let c = grad(x);
+            *b = [c[0] * d[0], c[1] * d[1], c[2] * d[0], c[3] * d[1]];
+        }
     }
 
     /// The velocity transfer in use.

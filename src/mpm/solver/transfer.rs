@@ -443,16 +443,10 @@ impl<S> Scatter<'_, S> {
             // APIC: C = B D⁻¹ with D = diag(Σ w_x d_x², Σ w_y d_y²) here.
             let (mut c, mut dx, mut dy) = ([0.0; 4], [0.0; 3], [0.0; 3]);
             if APIC {
-                let x = pts.pos[q];
-                let (mut ddx, mut ddy) = (0.0, 0.0);
-                for k in 0..3 {
-                    dx[k] = origin[0] + (st.i0 + k as i64) as f64 * h - x[0];
-                    dy[k] = origin[1] + (st.j0 + k as i64) as f64 * h - x[1];
-                    ddx += st.wx[k] * dx[k] * dx[k];
-                    ddy += st.wy[k] * dy[k] * dy[k];
-                }
+                let d;
+                (dx, dy, d) = st.apic_offsets(pts.pos[q], origin, h);
                 let bm = pts.affine[q];
-                c = [bm[0] / ddx, bm[1] / ddy, bm[2] / ddx, bm[3] / ddy];
+                c = [bm[0] / d[0], bm[1] / d[1], bm[2] / d[0], bm[3] / d[1]];
             }
             for a in 0..3 {
                 let base = (st.i0 + a as i64 - col0) as usize * nny + st.j0 as usize;

@@ -5,8 +5,10 @@
 //!
 //! A geostatic start, σ_yy = −ρ g (H − y), σ_xx = σ_zz = K₀ σ_yy, puts an elastic column in
 //! equilibrium with its weight from the first step instead of letting it drop and ring; a
-//! velocity field starts a block moving (the APIC affine matrices start at zero, so an
-//! `apic` transfer sees the field's gradient from the first grid update on).
+//! velocity field starts a block moving, and with the `apic` transfer the points' affine
+//! matrices start at the field's gradient (the expressions' derivatives), so that the first
+//! transfer to the grid carries it: a rigid rotation or any affine field reaches the grid
+//! exactly ([`Mpm::set_velocity_gradient`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -129,6 +131,17 @@ pub fn start<M: Material>(
         if let Some(u) = given.velocity(x) {
             *v = u;
         }
+    }
+    if let Some(parts) = &given.velocity {
+        mpm.set_velocity_gradient(|x| {
+            let [u, v] = parts;
+            [
+                u.at(1, x[0], x[1]),
+                u.at(2, x[0], x[1]),
+                v.at(1, x[0], x[1]),
+                v.at(2, x[0], x[1]),
+            ]
+        });
     }
     Ok(())
 }

@@ -293,8 +293,9 @@ pub fn find_case(cases: &[Case], which: &str) -> Result<usize> {
 
 /// Runs one case of the sweep of `path` (see [`find_case`]) into its folder under `out`, as
 /// a job of a scheduler's array does: the same folder, reuse and checkpoints as a whole
-/// sweep, and nothing written outside the case's folder. A later `granflow sweep` of the same
-/// file and `out` reuses the case and, once every case is done, writes the tables.
+/// sweep, and nothing written outside the case's folder but `out`'s run-folder marker. A
+/// later `granflow sweep` of the same file and `out` reuses the case (and runs any still
+/// missing) and writes the tables.
 pub fn run_one_case(
     path: &Path,
     out: &Path,

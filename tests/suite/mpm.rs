@@ -265,30 +265,47 @@ fn mpm_friction_sliding_block() {
     case_passes("mpm-friction");
 }
 
+/// An elastic block filling [0.1, 0.2]² m with 2 × 2 points per cell of size `h`, free (no
+/// gravity, no walls) on a grid of 0.4 m square.
+fn free_elastic_block(
+    h: f64,
+    shape: granflow::mpm::ShapeKind,
+    pic_fraction: f64,
+    dt: Option<f64>,
+) -> granflow::mpm::Mpm<granflow::mpm::MaterialModel> {
+    use granflow::mpm::*;
+    let mut pts = Points::default();
+    pts.fill_rect([0.1, 0.1], [0.2, 0.2], h, 2, 1000.0);
+    let mat = MaterialModel::Elastic(LinearElastic {
+        density: 1000.0,
+        youngs_modulus: 1e6,
+        poisson_ratio: 0.3,
+    });
+    let params = MpmParams {
+        shape,
+        scheme: Scheme::Musl,
+        gravity: [0.0, 0.0],
+        courant: 0.5,
+        dt,
+        damping: 0.0,
+        pic_fraction,
+        resort_every: 1000,
+    };
+    let cells = (0.4 / h).round() as usize;
+    Mpm::new(
+        Grid::new(cells, cells, h, [0.0; 2], vec![]),
+        pts,
+        mat,
+        params,
+    )
+    .unwrap()
+}
+
 /// APIC is refused with standard MPM shape functions and with a PIC fraction, naming the field.
 #[test]
 fn apic_is_refused_where_it_is_undefined() {
     use granflow::mpm::*;
-    let make = |shape: ShapeKind, pic: f64| {
-        let mut pts = Points::default();
-        pts.fill_rect([0.1, 0.1], [0.2, 0.2], 0.05, 2, 1000.0);
-        let mat = MaterialModel::Elastic(LinearElastic {
-            density: 1000.0,
-            youngs_modulus: 1e6,
-            poisson_ratio: 0.3,
-        });
-        let params = MpmParams {
-            shape,
-            scheme: Scheme::Musl,
-            gravity: [0.0, 0.0],
-            courant: 0.5,
-            dt: None,
-            damping: 0.0,
-            pic_fraction: pic,
-            resort_every: 20,
-        };
-        Mpm::new(Grid::new(8, 8, 0.05, [0.0; 2], vec![]), pts, mat, params).unwrap()
-    };
+    let make = |shape, pic| free_elastic_block(0.05, shape, pic, None);
     let e = make(ShapeKind::Standard, 0.0)
         .set_transfer(Transfer::Apic)
         .unwrap_err()
@@ -537,25 +554,7 @@ fn apic_starts_from_the_velocity_gradient() {
     use granflow::mpm::*;
     use granflow::scenario::mpm::initial::{start, MpmInitialSpec};
     let spinning = |gradient: bool| {
-        let mut pts = Points::default();
-        pts.fill_rect([0.1, 0.1], [0.2, 0.2], 0.025, 2, 1000.0);
-        let mat = MaterialModel::Elastic(LinearElastic {
-            density: 1000.0,
-            youngs_modulus: 1e6,
-            poisson_ratio: 0.3,
-        });
-        let params = MpmParams {
-            shape: ShapeKind::Gimp,
-            scheme: Scheme::Musl,
-            gravity: [0.0, 0.0],
-            courant: 0.5,
-            dt: Some(1e-4),
-            damping: 0.0,
-            pic_fraction: 0.0,
-            resort_every: 1000,
-        };
-        let grid = Grid::new(12, 12, 0.025, [0.0; 2], vec![]);
-        let mut mpm = Mpm::new(grid, pts, mat, params).unwrap();
+        let mut mpm = free_elastic_block(0.025, ShapeKind::Gimp, 0.0, Some(1e-4));
         mpm.set_transfer(Transfer::Apic).unwrap();
         let spec: MpmInitialSpec =
             toml::from_str("velocity = [\"-2*(y - 0.15)\", \"2*(x - 0.15)\"]").unwrap();
